@@ -1,0 +1,48 @@
+"""Errors that reach the user as one clear line.
+
+``InputError`` names the input key, the value given and the allowed range; the command line turns it
+into exit status 2.  ``ConvergenceError`` says which iteration failed and its last residual.
+"""
+
+from __future__ import annotations
+
+__all__ = ["InputError", "ConvergenceError", "check_range"]
+
+
+class InputError(ValueError):
+    """Bad input: ``key`` (dotted path, e.g. ``girder.mass_per_length_kg_m``), ``value``, ``allowed``."""
+
+    def __init__(self, key: str, value: object, allowed: str):
+        self.key, self.value, self.allowed = key, value, allowed
+        super().__init__(f"{key} = {value!r}: {allowed}")
+
+
+class ConvergenceError(RuntimeError):
+    """An iteration that did not converge; the message carries the last residual."""
+
+    def __init__(self, what: str, iterations: int, residual: float, tolerance: float):
+        self.what, self.iterations, self.residual, self.tolerance = what, iterations, residual, tolerance
+        super().__init__(
+            f"{what} did not converge in {iterations} iterations: last residual {residual:.3e} "
+            f"(tolerance {tolerance:.1e})"
+        )
+
+
+def check_range(key: str, value: float, low: float | None = None, high: float | None = None,
+                low_open: bool = False, high_open: bool = False) -> float:
+    """Return ``float(value)`` if it lies in the range, else raise :class:`InputError` naming it.
+
+    ``low_open``/``high_open`` exclude the end point (``low_open=True, low=0`` means "> 0").
+    """
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise InputError(key, value, "must be a number")
+    v = float(value)
+    if v != v:
+        raise InputError(key, value, "must be a number, not NaN")
+    lo_ok = low is None or (v > low if low_open else v >= low)
+    hi_ok = high is None or (v < high if high_open else v <= high)
+    if not (lo_ok and hi_ok):
+        lo = "" if low is None else (f"> {low:g}" if low_open else f">= {low:g}")
+        hi = "" if high is None else (f"< {high:g}" if high_open else f"<= {high:g}")
+        raise InputError(key, value, "allowed range " + " and ".join(s for s in (lo, hi) if s))
+    return v
