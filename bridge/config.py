@@ -1,0 +1,527 @@
+"""Scenarios: the inputs of one bridge, read from TOML and validated.
+
+A scenario file is TOML with units in the key names (``main_span_m``, ``mass_per_length_kg_m``).
+Two forms exist:
+
+* a full bridge (``scenarios/great_belt.toml``): every input of the thesis, sections 1.4, 3.2, Table 3.1-3.4;
+* an up-scaled bridge (``scenarios/model_c.toml``): ``reference = "great_belt"`` and ``main_span_m = 4000``;
+  the up-scaled inputs are computed by :mod:`bridge.upscaling` (thesis 1.5), never typed in.
+
+A third kind, ``kind = "section"``, is a 2-DOF sectional model for flutter checks (see
+:mod:`bridge.flutter.section`).
+
+Every value is checked when read: a missing or unknown key, a wrong type or a value outside its range
+raises :class:`bridge.errors.InputError` naming the dotted key, the value and the allowed range.
+Derived quantities (mu and J of Eq 4.7, shear modulus, box-section properties) are computed, never
+stored twice.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass, field, fields, replace
+from pathlib import Path
+from typing import Any, Mapping
+
+from .errors import InputError, check_range
+
+__all__ = [
+    "Material", "BoxSection", "Geometry", "Girder", "Cable", "Hanger", "Pylon", "DampingEntry", "Air",
+    "Scenario", "load_scenario", "scenario_path", "SCENARIO_DIR", "GRAVITY_M_S2",
+]
+
+GRAVITY_M_S2 = 9.81  # the thesis's value (Eq 1.2, 2.3)
+SCENARIO_DIR = Path(__file__).resolve().parent.parent / "scenarios"
+
+
+# ----------------------------------------------------------------------------------------- reading helpers
+class _Table:
+    """A TOML table being read: tracks which keys were used so unknown keys can be rejected."""
+
+    def __init__(self, data: Mapping[str, Any], where: str):
+        if not isinstance(data, Mapping):
+            raise InputError(where, data, "must be a table")
+        self.data, self.where, self.used = data, where, set()
+
+    def key(self, name: str) -> str:
+        return f"{self.where}.{name}" if self.where else name
+
+    def raw(self, name: str, default: Any = ...) -> Any:
+        self.used.add(name)
+        if name not in self.data:
+            if default is ...:
+                raise InputError(self.key(name), None, "missing (required key)")
+            return default
+        return self.data[name]
+
+    def number(self, name: str, low: float | None = 0.0, high: float | None = None, low_open: bool = True,
+               high_open: bool = False, default: Any = ...) -> float:
+        value = self.raw(name, default)
+        return check_range(self.key(name), value, low, high, low_open, high_open)
+
+    def integer(self, name: str, low: int = 0, high: int | None = None, default: Any = ...) -> int:
+        value = self.raw(name, default)
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise InputError(self.key(name), value, "must be an integer")
+        check_range(self.key(name), value, low, high)
+        return value
+
+    def string(self, name: str, choices: tuple[str, ...] | None = None, default: Any = ...) -> str:
+        value = self.raw(name, default)
+        if not isinstance(value, str):
+            raise InputError(self.key(name), value, "must be a string")
+        if choices is not None and value not in choices:
+            raise InputError(self.key(name), value, f"must be one of {', '.join(choices)}")
+        return value
+
+    def table(self, name: str, default: Any = ...) -> "_Table":
+        value = self.raw(name, default)
+        return _Table(value, self.key(name))
+
+    def done(self) -> None:
+        unknown = sorted(set(self.data) - self.used)
+        if unknown:
+            raise InputError(self.key(unknown[0]), self.data[unknown[0]], "unknown key")
+
+
+# ----------------------------------------------------------------------------------------- data classes
+@dataclass(frozen=True)
+class Material:
+    """Linear elastic isotropic material (thesis Table 3.1)."""
+
+    name: str
+    youngs_modulus_Pa: float
+    poisson_ratio: float
+    density_kg_m3: float
+
+    def __post_init__(self) -> None:
+        check_range(f"materials.{self.name}.youngs_modulus_Pa", self.youngs_modulus_Pa, 0.0, low_open=True)
+        check_range(f"materials.{self.name}.poisson_ratio", self.poisson_ratio, 0.0, 0.5, high_open=True)
+        check_range(f"materials.{self.name}.density_kg_m3", self.density_kg_m3, 0.0, low_open=True)
+
+    @property
+    def shear_modulus_Pa(self) -> float:
+        return self.youngs_modulus_Pa / (2.0 * (1.0 + self.poisson_ratio))
+
+
+@dataclass(frozen=True)
+class BoxSection:
+    """Thin-walled rectangular box, outer sides ``a`` x ``b``, wall ``t`` (thesis Table 3.2, Fig 3.2).
+
+    ``a`` is taken along the bridge axis and ``b`` across it for legs; for cross beams ``a`` is the
+    width (horizontal, along the bridge) and ``b`` the depth (vertical).  Torsion by Bredt's formula on
+    the wall centre line.
+    """
+
+    a_m: float
+    b_m: float
+    t_m: float
+
+    def __post_init__(self) -> None:
+        check_range("section.a_m", self.a_m, 0.0, low_open=True)
+        check_range("section.b_m", self.b_m, 0.0, low_open=True)
+        if not (0.0 < self.t_m < 0.5 * min(self.a_m, self.b_m)):
+            raise InputError("section.t_m", self.t_m, f"must be > 0 and < half the smaller side "
+                             f"({0.5 * min(self.a_m, self.b_m):g} m)")
+
+    @property
+    def area_m2(self) -> float:
+        return self.a_m * self.b_m - (self.a_m - 2 * self.t_m) * (self.b_m - 2 * self.t_m)
+
+    @property
+    def i_about_a_m4(self) -> float:
+        """Second moment for bending with the neutral axis parallel to side ``a``: (a b^3 - a_i b_i^3)/12."""
+        ai, bi = self.a_m - 2 * self.t_m, self.b_m - 2 * self.t_m
+        return (self.a_m * self.b_m**3 - ai * bi**3) / 12.0
+
+    @property
+    def i_about_b_m4(self) -> float:
+        """Second moment for bending with the neutral axis parallel to side ``b``."""
+        ai, bi = self.a_m - 2 * self.t_m, self.b_m - 2 * self.t_m
+        return (self.b_m * self.a_m**3 - bi * ai**3) / 12.0
+
+    @property
+    def torsion_constant_m4(self) -> float:
+        """Bredt: J = 4 A_m^2 t / perimeter_m on the wall centre line."""
+        am, bm = self.a_m - self.t_m, self.b_m - self.t_m
+        return 4.0 * (am * bm) ** 2 * self.t_m / (2.0 * (am + bm))
+
+    def scaled(self, factor: float) -> "BoxSection":
+        """All three dimensions times ``factor``: inertia scales as factor**4, area as factor**2."""
+        return BoxSection(self.a_m * factor, self.b_m * factor, self.t_m * factor)
+
+
+@dataclass(frozen=True)
+class Geometry:
+    """Spans, sag and levels (thesis 1.4, Table 1.2).  Elevations are above the pylon foundations.
+
+    The deck is horizontal (thesis 3.1) at ``girder_elevation_m``; the cable low point at mid-span is
+    ``pylon_height_m - sag_m``; the side-span anchors lie at that same level (Eq 2.10: y(L_s) = h).
+    """
+
+    main_span_m: float
+    side_span_m: float
+    sag_m: float
+    hanger_spacing_target_m: float
+    cable_plane_spacing_m: float
+    girder_elevation_m: float
+    pylon_height_m: float
+
+    def __post_init__(self) -> None:
+        check_range("geometry.main_span_m", self.main_span_m, 0.0, low_open=True)
+        check_range("geometry.side_span_m", self.side_span_m, 0.0, low_open=True)
+        check_range("geometry.sag_m", self.sag_m, 0.0, low_open=True)
+        check_range("geometry.sag_ratio (sag_m / main_span_m)", self.sag_m / self.main_span_m, 1 / 20, 1 / 5)
+        check_range("geometry.hanger_spacing_target_m", self.hanger_spacing_target_m, 0.0,
+                    self.main_span_m / 4, low_open=True)
+        check_range("geometry.cable_plane_spacing_m", self.cable_plane_spacing_m, 0.0, low_open=True)
+        check_range("geometry.girder_elevation_m", self.girder_elevation_m, 0.0, low_open=True)
+        if self.cable_low_point_m <= self.girder_elevation_m:
+            raise InputError("geometry.pylon_height_m", self.pylon_height_m,
+                             f"must exceed girder_elevation_m + sag_m = "
+                             f"{self.girder_elevation_m + self.sag_m:g} (cable above the deck at mid-span)")
+
+    @property
+    def cable_low_point_m(self) -> float:
+        return self.pylon_height_m - self.sag_m
+
+    @property
+    def sag_ratio(self) -> float:
+        return self.sag_m / self.main_span_m
+
+    @property
+    def total_length_m(self) -> float:
+        """Deck length L of Eq 4.5/4.34: main span plus both side spans."""
+        return self.main_span_m + 2.0 * self.side_span_m
+
+
+@dataclass(frozen=True)
+class Girder:
+    """Bridge girder (thesis Table 3.3).  i_vertical = I_yy (weak axis, vertical bending), i_lateral = I_xx,
+    torsion_constant = I_zz (St Venant), mass_moment_of_inertia = J_b (Eq 3.1)."""
+
+    area_m2: float
+    i_vertical_m4: float
+    i_lateral_m4: float
+    torsion_constant_m4: float
+    mass_per_length_kg_m: float
+    mass_moment_of_inertia_kg_m2_m: float
+    width_m: float
+    material: str
+
+
+@dataclass(frozen=True)
+class Cable:
+    """One main cable (thesis 1.4, 3.2.1).  ``allowable_stress_Pa`` is sigma_0 of Eq 1.1, the design rule
+    the up-scaling keeps (Eq 1.2)."""
+
+    area_m2: float
+    mass_per_length_main_kg_m: float
+    mass_per_length_side_kg_m: float
+    allowable_stress_Pa: float
+    material: str
+
+    @property
+    def density_kg_m3(self) -> float:
+        """rho_c = mu_c / A_c: the cable's effective density (wires, wrapping, clamps)."""
+        return self.mass_per_length_main_kg_m / self.area_m2
+
+
+@dataclass(frozen=True)
+class Hanger:
+    """Hanger pair modelled as one (thesis 3.2.2): area of both together."""
+
+    area_m2: float
+    density_kg_m3: float
+    material: str
+
+
+@dataclass(frozen=True)
+class Pylon:
+    """Concrete pylon: two vertical legs in the cable planes, joined by cross beams (thesis 3.2.3, Table 3.2).
+
+    Lower leg section from foundation to girder level, upper leg section above it.  ``extra_cross_beams``
+    are added evenly between the lower and upper cross beams in up-scaled models (thesis 1.5, Fig 1.1).
+    """
+
+    lower_leg: BoxSection
+    upper_leg: BoxSection
+    lower_cross_beam: BoxSection
+    upper_cross_beam: BoxSection
+    lower_cross_beam_elevation_m: float
+    upper_cross_beam_elevation_m: float
+    extra_cross_beams: int
+    material: str
+
+    @property
+    def cross_beam_elevations_m(self) -> tuple[float, ...]:
+        """All cross-beam levels, bottom to top, extra beams evenly spaced between lower and upper."""
+        lo, hi, n = self.lower_cross_beam_elevation_m, self.upper_cross_beam_elevation_m, self.extra_cross_beams
+        return tuple(lo + (hi - lo) * i / (n + 1) for i in range(n + 2))
+
+
+@dataclass(frozen=True)
+class DampingEntry:
+    """One row of thesis Table 3.4: measured mode, its symmetry, frequency and damping ratio."""
+
+    symmetry: str
+    frequency_hz: float
+    ratio: float
+
+
+@dataclass(frozen=True)
+class Air:
+    density_kg_m3: float = 1.225
+    kinematic_viscosity_m2_s: float = 1.48e-5
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """All inputs of one run.  ``reference_name``/``scale`` say how an up-scaled bridge was made."""
+
+    name: str
+    kind: str
+    description: str
+    geometry: Geometry | None = None
+    girder: Girder | None = None
+    cable: Cable | None = None
+    hanger: Hanger | None = None
+    pylon: Pylon | None = None
+    materials: Mapping[str, Material] = field(default_factory=dict)
+    damping: tuple[DampingEntry, ...] = ()
+    air: Air = Air()
+    reference_name: str | None = None
+    source_path: str | None = None
+    flutter: Any = None   # bridge.flutter.options.FlutterOptions
+    section: Any = None   # bridge.flutter.section.SectionModel (kind == "section")
+    modal: Any = None     # bridge.flutter.modal.ModalModel given directly
+
+    # Eq 4.7 ------------------------------------------------------------------------------------------
+    @property
+    def deck_mass_per_length_kg_m(self) -> float:
+        """mu = mu_b + 2 mu_c (Eq 4.7 context, Table 3.6): girder plus both main cables."""
+        return self.girder.mass_per_length_kg_m + 2.0 * self.cable.mass_per_length_main_kg_m
+
+    @property
+    def deck_inertia_per_length_kg_m2_m(self) -> float:
+        """J = J_b + (B^2/2) mu_c (Eq 4.7), B the distance between the cable planes."""
+        b = self.geometry.cable_plane_spacing_m
+        return self.girder.mass_moment_of_inertia_kg_m2_m + 0.5 * b * b * self.cable.mass_per_length_main_kg_m
+
+    def material(self, name: str) -> Material:
+        return self.materials[name]
+
+    def with_main_span(self, main_span_m: float) -> "Scenario":
+        from .upscaling import upscale  # local import: upscaling needs this module
+
+        return upscale(self, main_span_m)
+
+
+# ----------------------------------------------------------------------------------------- parsing
+_KINDS = ("suspension_bridge", "section")
+
+
+def _box(t: _Table, name: str) -> BoxSection:
+    s = t.table(name)
+    try:
+        box = BoxSection(s.number("a_m"), s.number("b_m"), s.number("t_m"))
+    except InputError as err:  # re-key the message to the full dotted path
+        raise InputError(s.key(err.key.split(".")[-1]), err.value, err.allowed) from None
+    s.done()
+    return box
+
+
+def _materials(t: _Table) -> dict[str, Material]:
+    out = {}
+    for name in t.data:
+        m = t.table(name)
+        out[name] = Material(name, m.number("youngs_modulus_Pa"), m.number("poisson_ratio", 0.0, 0.5,
+                             low_open=False, high_open=True), m.number("density_kg_m3"))
+        m.done()
+    if not out:
+        raise InputError("materials", {}, "needs at least one material table")
+    return out
+
+
+def _material_name(t: _Table, materials: Mapping[str, Material]) -> str:
+    name = t.string("material")
+    if name not in materials:
+        raise InputError(t.key("material"), name, f"must be one of the [materials] tables: {', '.join(materials)}")
+    return name
+
+
+def _parse_bridge(t: _Table, name: str, description: str, source: str | None) -> Scenario:
+    materials = _materials(t.table("materials"))
+
+    g = t.table("geometry")
+    geometry = Geometry(
+        main_span_m=g.number("main_span_m"), side_span_m=g.number("side_span_m"), sag_m=g.number("sag_m"),
+        hanger_spacing_target_m=g.number("hanger_spacing_target_m"),
+        cable_plane_spacing_m=g.number("cable_plane_spacing_m"),
+        girder_elevation_m=g.number("girder_elevation_m"), pylon_height_m=g.number("pylon_height_m"))
+    g.done()
+
+    b = t.table("girder")
+    girder = Girder(
+        area_m2=b.number("area_m2"), i_vertical_m4=b.number("i_vertical_m4"),
+        i_lateral_m4=b.number("i_lateral_m4"), torsion_constant_m4=b.number("torsion_constant_m4"),
+        mass_per_length_kg_m=b.number("mass_per_length_kg_m"),
+        mass_moment_of_inertia_kg_m2_m=b.number("mass_moment_of_inertia_kg_m2_m"),
+        width_m=b.number("width_m"), material=_material_name(b, materials))
+    b.done()
+
+    c = t.table("cable")
+    cable = Cable(
+        area_m2=c.number("area_m2"), mass_per_length_main_kg_m=c.number("mass_per_length_main_kg_m"),
+        mass_per_length_side_kg_m=c.number("mass_per_length_side_kg_m"),
+        allowable_stress_Pa=c.number("allowable_stress_Pa"), material=_material_name(c, materials))
+    c.done()
+
+    h = t.table("hanger")
+    hanger = Hanger(area_m2=h.number("area_m2"), density_kg_m3=h.number("density_kg_m3"),
+                    material=_material_name(h, materials))
+    h.done()
+
+    p = t.table("pylon")
+    pylon = Pylon(
+        lower_leg=_box(p, "lower_leg"), upper_leg=_box(p, "upper_leg"),
+        lower_cross_beam=_box(p, "lower_cross_beam"), upper_cross_beam=_box(p, "upper_cross_beam"),
+        lower_cross_beam_elevation_m=p.number("lower_cross_beam_elevation_m"),
+        upper_cross_beam_elevation_m=p.number("upper_cross_beam_elevation_m"),
+        extra_cross_beams=p.integer("extra_cross_beams", 0, 10, default=0),
+        material=_material_name(p, materials))
+    p.done()
+    if not pylon.lower_cross_beam_elevation_m < pylon.upper_cross_beam_elevation_m <= geometry.pylon_height_m:
+        raise InputError("pylon.upper_cross_beam_elevation_m", pylon.upper_cross_beam_elevation_m,
+                         f"must lie above lower_cross_beam_elevation_m ({pylon.lower_cross_beam_elevation_m:g}) "
+                         f"and not above geometry.pylon_height_m ({geometry.pylon_height_m:g})")
+
+    d = t.table("damping")
+    rows = d.raw("modes")
+    if not isinstance(rows, list) or not rows:
+        raise InputError(d.key("modes"), rows, "must be a non-empty list of {symmetry, frequency_hz, ratio}")
+    damping = []
+    for i, row in enumerate(rows):
+        r = _Table(row, f"damping.modes[{i}]")
+        damping.append(DampingEntry(r.string("symmetry", ("S", "SS")), r.number("frequency_hz"),
+                                    r.number("ratio", 0.0, 0.2, low_open=False)))
+        r.done()
+    d.done()
+
+    a = t.table("air", default={})
+    air = Air(a.number("density_kg_m3", default=1.225), a.number("kinematic_viscosity_m2_s", default=1.48e-5))
+    a.done()
+
+    return Scenario(name=name, kind="suspension_bridge", description=description, geometry=geometry,
+                    girder=girder, cable=cable, hanger=hanger, pylon=pylon, materials=materials,
+                    damping=tuple(damping), air=air, source_path=source)
+
+
+def _parse_optional_tables(t: _Table, scenario: Scenario) -> Scenario:
+    """[flutter], [section] and [modal] tables belong to the flutter package, which validates them."""
+    updates: dict[str, Any] = {}
+    if "flutter" in t.data:
+        from .flutter.options import FlutterOptions
+
+        updates["flutter"] = FlutterOptions.from_mapping(t.raw("flutter"), "flutter")
+    if "section" in t.data:
+        from .flutter.section import SectionModel
+
+        updates["section"] = SectionModel.from_mapping(t.raw("section"), "section")
+    if "modal" in t.data:
+        from .flutter.modal import ModalModel
+
+        updates["modal"] = ModalModel.from_mapping(t.raw("modal"), "modal")
+    return replace(scenario, **updates) if updates else scenario
+
+
+def scenario_path(name_or_path: str | Path) -> Path:
+    """``great_belt`` -> ``scenarios/great_belt.toml``; an existing path is used as given."""
+    p = Path(name_or_path)
+    if p.suffix == ".toml" or p.exists():
+        if not p.is_file():
+            raise InputError("scenario", str(name_or_path), "file not found")
+        return p
+    candidate = SCENARIO_DIR / f"{name_or_path}.toml"
+    if not candidate.is_file():
+        known = sorted(q.stem for q in SCENARIO_DIR.glob("*.toml"))
+        raise InputError("scenario", str(name_or_path), f"not a file and not one of: {', '.join(known)}")
+    return candidate
+
+
+def load_scenario(name_or_path: str | Path, main_span_m: float | None = None, _seen: tuple = ()) -> Scenario:
+    """Read, validate and (if the file names a reference) up-scale a scenario.
+
+    ``main_span_m`` overrides the file's main span (command line ``--main-span``): the reference bridge
+    is then up-scaled to it with the rules of thesis 1.5.
+    """
+    path = scenario_path(name_or_path)
+    try:
+        with open(path, "rb") as fh:
+            data = tomllib.load(fh)
+    except tomllib.TOMLDecodeError as err:
+        raise InputError("scenario", str(path), f"is not valid TOML ({err})") from None
+    t = _Table(data, "")
+    name = t.string("name", default=path.stem)
+    description = t.string("description", default="")
+
+    if "reference" in data:  # an up-scaled bridge
+        ref = t.string("reference")
+        if ref in _seen:
+            raise InputError("reference", ref, "circular reference between scenario files")
+        span = t.number("main_span_m")
+        reference = load_scenario(path.parent / f"{ref}.toml" if (path.parent / f"{ref}.toml").exists() else ref,
+                                  _seen=_seen + (name,))
+        target = main_span_m if main_span_m is not None else span
+        if main_span_m is not None and not math.isclose(main_span_m, span):
+            name = f"{name}_L{main_span_m:g}"
+        scenario = reference.with_main_span(target)
+        scenario = replace(scenario, name=name, description=description or scenario.description,
+                           source_path=str(path))
+        scenario = _parse_optional_tables(t, scenario)
+        t.done()
+        return scenario
+
+    kind = t.string("kind", _KINDS, default="suspension_bridge")
+    if kind == "section":
+        scenario = Scenario(name=name, kind=kind, description=description, source_path=str(path))
+        a = t.table("air", default={})
+        scenario = replace(scenario, air=Air(a.number("density_kg_m3", default=1.225),
+                                             a.number("kinematic_viscosity_m2_s", default=1.48e-5)))
+        a.done()
+        scenario = _parse_optional_tables(t, scenario)
+        if scenario.section is None:
+            raise InputError("section", None, "missing: a scenario of kind 'section' needs a [section] table")
+        if main_span_m is not None:
+            raise InputError("--main-span", main_span_m, "only applies to bridge scenarios, not to kind 'section'")
+        t.done()
+        return scenario
+
+    scenario = _parse_bridge(t, name, description, str(path))
+    scenario = _parse_optional_tables(t, scenario)
+    t.done()
+    if main_span_m is not None and not math.isclose(main_span_m, scenario.geometry.main_span_m):
+        scenario = replace(scenario.with_main_span(main_span_m), name=f"{name}_L{main_span_m:g}")
+    return scenario
+
+
+def scenario_fields(obj: Any) -> dict[str, Any]:
+    """Flatten a dataclass tree into ``{"geometry.main_span_m": 1624.0, ...}`` (for reports and HDF5 attrs)."""
+    out: dict[str, Any] = {}
+
+    def walk(prefix: str, value: Any) -> None:
+        if hasattr(value, "__dataclass_fields__"):
+            for f in fields(value):
+                walk(f"{prefix}.{f.name}" if prefix else f.name, getattr(value, f.name))
+        elif isinstance(value, Mapping):
+            for k, v in value.items():
+                walk(f"{prefix}.{k}", v)
+        elif isinstance(value, (tuple, list)) and value and hasattr(value[0], "__dataclass_fields__"):
+            for i, v in enumerate(value):
+                walk(f"{prefix}[{i}]", v)
+        elif isinstance(value, (int, float, str)) and not isinstance(value, bool):
+            out[prefix] = value
+
+    walk("", obj)
+    return out
