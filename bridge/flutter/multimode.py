@@ -1,0 +1,132 @@
+"""Multimode flutter by the p-k method (N modes coupled by the aerodynamic matrix).
+
+Modal equations (Eq 4.9) for all N modes with the aeroelastic modal load of Eq 4.23-4.24:
+    M q'' + C q' + K q = A_a(w, V) q,  M = diag(m_i), C = diag(2 m_i zeta_i w_i), K = diag(m_i w_i^2),
+    A_a[i, j] = (1/2) rho V^2 L [h_pu uu_ij + B h_ptheta ut_ij + B h_mu ut_ji + B^2 h_mtheta tt_ij].
+p-k: for q = Q e^{s t}, A_a is evaluated at the trial frequency w (Omega = w B / V) and split as
+A_a = A_R + i A_I ~ A_R + (A_I / w) s, which is exact on the imaginary axis (s = i w).  Then
+    [s^2 M + s (C - A_I / w) + (K - A_R)] Q = 0
+is a real quadratic eigenvalue problem (state-space form, 2N eigenvalues); for each mode the trial w is
+replaced by Im(s) of the tracked eigenvalue until it no longer changes.  Damping ratio
+zeta = -Re(s) / |s|, frequency Im(s) / 2 pi.  Flutter: the first V where a damping ratio crosses zero
+(refined by Brent's method on zeta(V)).  At that point s = i w exactly, so with two modes the p-k
+critical speed is the determinant method's (Eq 4.29) to the iteration tolerance.
+Lateral modes carry no aerodynamic FRF in the thesis's model and are left out.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import brentq
+
+from bridge.errors import ConvergenceError, InputError, check_range
+from bridge.flutter.aerodynamics import AerodynamicModel
+from bridge.flutter.determinant import _aero_bracket
+from bridge.flutter.modal import ModalModel
+
+__all__ = ["MultimodeResult", "pk_sweep", "aeroelastic_eigenvalues"]
+
+
+@dataclass(frozen=True)
+class MultimodeResult:
+    """Frequencies and damping ratios of every mode against V, and the flutter onset.
+
+    ``speed_m_s`` (n_V,), ``frequency_hz`` and ``damping_ratio`` (n_V, N) in the order of ``labels``.
+    ``flutter`` False: no damping ratio crossed zero up to ``max_speed_searched_m_s``.
+    """
+
+    labels: tuple[str, ...]
+    speed_m_s: np.ndarray
+    frequency_hz: np.ndarray
+    damping_ratio: np.ndarray
+    flutter: bool
+    critical_speed_m_s: float
+    frequency_hz_at_flutter: float
+    reduced_frequency: float
+    unstable_mode: str
+    max_speed_searched_m_s: float
+
+
+def _state_matrix(model: ModalModel, aero: AerodynamicModel, rho: float, w: float, V: float) -> np.ndarray:
+    B, L = model.deck_width_m, model.deck_length_m
+    m, wi, zi = model.modal_masses, model.angular_frequencies, model.damping_ratios
+    A = 0.5 * rho * V**2 * L * _aero_bracket(model, aero.frf(w * B / V, V))    # Eq 4.24, 4.37
+    K = np.diag(m * wi**2) - A.real
+    C = np.diag(2.0 * m * zi * wi) - A.imag / w
+    n = model.n_modes
+    S = np.zeros((2 * n, 2 * n))
+    S[:n, n:] = np.eye(n)
+    S[n:, :n] = -K / m[:, None]
+    S[n:, n:] = -C / m[:, None]
+    return S
+
+
+def aeroelastic_eigenvalues(model: ModalModel, aero: AerodynamicModel, air_density: float, speed: float,
+                            guesses: np.ndarray, tolerance: float = 1e-10, max_iterations: int = 200) -> np.ndarray:
+    """p-k eigenvalue s_r of each mode at wind speed V, iterating on frequency from ``guesses``
+    (complex, one per mode: the previous speed's eigenvalues, or i w_r at the first speed)."""
+    out = np.empty(model.n_modes, dtype=np.complex128)
+    for r, s_prev in enumerate(np.asarray(guesses, dtype=np.complex128)):
+        s = s_prev
+        w = max(abs(s.imag), 1e-6 * model.angular_frequencies.min())
+        for it in range(max_iterations):
+            lam = np.linalg.eigvals(_state_matrix(model, aero, air_density, w, speed))
+            lam = lam[lam.imag >= 0.0]
+            s = lam[np.argmin(np.abs(lam - s))]
+            w_new = max(s.imag, 1e-6 * model.angular_frequencies.min())
+            if abs(w_new - w) <= tolerance * w:
+                break
+            w = w_new
+        else:
+            raise ConvergenceError(f"p-k frequency iteration, mode {model.labels[r]} at V = {speed:g} m/s",
+                                   max_iterations, abs(w_new - w) / w, tolerance)
+        out[r] = s
+    return out
+
+
+def _damping(s: np.ndarray) -> np.ndarray:
+    return -s.real / np.abs(s)
+
+
+def pk_sweep(model: ModalModel, aero: AerodynamicModel, air_density: float, max_speed_m_s: float,
+             min_speed_m_s: float | None = None, n_speed: int = 120, tolerance: float = 1e-10) -> MultimodeResult:
+    """Damping and frequency of every (vertical or torsional) mode for V in [V_min, V_max], and the
+    lowest V where a damping ratio crosses zero from above."""
+    keep = [i for i in range(model.n_modes) if model.kinds[i] != "lateral"]
+    if len(keep) < 2:
+        raise InputError("flutter.modes", model.labels, "multimode flutter needs >= 2 vertical/torsional modes")
+    model = model.subset(keep)
+    check_range("flutter.air_density_kg_m3", air_density, low=0.0, low_open=True)
+    v_hi = check_range("flutter.max_speed_m_s", max_speed_m_s, low=0.0, low_open=True)
+    s_lo, s_hi = aero.speed_range
+    if v_hi > s_hi * (1 + 1e-12):
+        raise InputError("flutter.max_speed_m_s", v_hi,
+                         f"the aerodynamic model covers V in [{s_lo:g}, {s_hi:g}]; no extrapolation")
+    v_lo = max(s_lo, 0.01 * v_hi) if min_speed_m_s is None else check_range(
+        "flutter.min_speed_m_s", min_speed_m_s, low=s_lo, high=v_hi, high_open=True)
+    speeds = np.linspace(v_lo, v_hi, int(n_speed))
+    s = 1j * model.angular_frequencies
+    eig = np.empty((speeds.size, model.n_modes), dtype=np.complex128)
+    for n, V in enumerate(speeds):
+        s = aeroelastic_eigenvalues(model, aero, air_density, V, s, tolerance)
+        eig[n] = s
+    zeta = _damping(eig)
+    freq = eig.imag / (2 * np.pi)
+    result = dict(labels=model.labels, speed_m_s=speeds, frequency_hz=freq, damping_ratio=zeta,
+                  max_speed_searched_m_s=float(v_hi))
+    crossing = np.flatnonzero((zeta[:-1] > 0.0) & (zeta[1:] <= 0.0))  # flat index over (n_V-1, N)
+    if crossing.size == 0:
+        return MultimodeResult(flutter=False, critical_speed_m_s=np.nan, frequency_hz_at_flutter=np.nan,
+                               reduced_frequency=np.nan, unstable_mode="", **result)
+    n0, r = np.unravel_index(crossing.min(), (speeds.size - 1, model.n_modes))  # lowest V first
+
+    def zeta_r(V: float) -> float:
+        return float(_damping(aeroelastic_eigenvalues(model, aero, air_density, V, eig[n0], tolerance))[r])
+
+    V_c = brentq(zeta_r, speeds[n0], speeds[n0 + 1], xtol=1e-12 * speeds[n0 + 1], rtol=1e-12)
+    s_c = aeroelastic_eigenvalues(model, aero, air_density, V_c, eig[n0], tolerance)[r]
+    return MultimodeResult(flutter=True, critical_speed_m_s=float(V_c), frequency_hz_at_flutter=float(s_c.imag / (2 * np.pi)),
+                           reduced_frequency=float(s_c.imag * model.deck_width_m / V_c),
+                           unstable_mode=model.labels[r], **result)
