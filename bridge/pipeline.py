@@ -1,0 +1,70 @@
+"""Running a scenario through its stages and writing the results.
+
+``run_scenario`` is what ``python -m bridge.scenario`` and the sweeps call: it resolves the requested
+stages with their prerequisites, runs them in order, and hands every output to
+:func:`bridge.results.write_results` (atomic: nothing is left behind if a stage fails).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Iterable
+
+from .config import Scenario
+from .errors import InputError
+from .results import write_results
+from .stages import STAGES, RunOptions, StageOutput, resolve_stage
+
+__all__ = ["plan_stages", "run_stages", "run_scenario", "default_stages"]
+
+# Stages that only make sense for one kind of scenario.
+_KIND_STAGES = {"suspension_bridge": ("cable", "fem", "flutter"), "section": ("flutter",)}
+
+
+def default_stages(scenario: Scenario) -> tuple[str, ...]:
+    """The registered stages a scenario of this kind runs when none are named."""
+    return tuple(s for s in _KIND_STAGES.get(scenario.kind, ()) if s in STAGES)
+
+
+def plan_stages(scenario: Scenario, requested: Iterable[str] | None) -> tuple[str, ...]:
+    """Requested stages plus their prerequisites, in registry order; unknown names are an InputError."""
+    wanted = list(requested) if requested is not None else list(default_stages(scenario))
+    for name in wanted:
+        if name not in STAGES:
+            raise InputError("--stages", name, f"unknown stage; known: {', '.join(STAGES)}")
+    needed: set[str] = set()
+
+    def need(name: str) -> None:
+        if name in needed:
+            return
+        needed.add(name)
+        for dep in STAGES[name][1]:
+            if scenario.kind == "section" and dep in ("cable", "fem"):
+                continue  # a sectional model carries its own modal data
+            need(dep)
+
+    for name in wanted:
+        need(name)
+    allowed = _KIND_STAGES.get(scenario.kind, ())
+    for name in needed:
+        if name not in allowed:
+            raise InputError("--stages", name, f"not available for a scenario of kind {scenario.kind!r} "
+                             f"(available: {', '.join(s for s in allowed if s in STAGES)})")
+    return tuple(s for s in STAGES if s in needed)
+
+
+def run_stages(scenario: Scenario, stages: Iterable[str] | None = None,
+               options: RunOptions = RunOptions()) -> dict[str, StageOutput]:
+    """Run the planned stages in memory and return their outputs (no files written)."""
+    outputs: dict[str, StageOutput] = {}
+    for name in plan_stages(scenario, stages):
+        outputs[name] = resolve_stage(name)(scenario, outputs, options)
+    return outputs
+
+
+def run_scenario(scenario: Scenario, out_dir: Path, stages: Iterable[str] | None = None,
+                 options: RunOptions = RunOptions()) -> tuple[Path, dict[str, StageOutput]]:
+    """Run the stages and write ``out_dir/<scenario.name>/``; return that folder and the outputs."""
+    outputs = run_stages(scenario, stages, options)
+    folder = write_results(Path(out_dir), scenario, outputs)
+    return folder, outputs
