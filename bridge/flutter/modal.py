@@ -210,3 +210,44 @@ class ModalModel:
                                   deck_width_m=deck_width_m, deck_length_m=1.0,
                                   bending_damping_ratio=heave_damping_ratio,
                                   torsion_damping_ratio=pitch_damping_ratio, labels=("heave", "pitch"))
+
+    # ---------------------------------------------------------------- scenario input
+    @classmethod
+    def from_mapping(cls, mapping, where: str = "modal") -> "ModalModel":
+        """A ``[modal]`` table of a scenario file.  Either the full form (keys = the field names;
+        uu, ut, tt as lists of rows) or the two-mode form of :meth:`from_two_modes` (keys
+        bending_frequency_hz, torsion_frequency_hz, a_jj, a_kk, a_jk, mass_per_length_kg_m,
+        inertia_per_length_kg_m2_m, deck_width_m, deck_length_m, optional bending_damping_ratio,
+        torsion_damping_ratio, labels).  Unknown or missing keys raise InputError naming ``where.key``."""
+        from collections.abc import Mapping
+        from dataclasses import fields
+        import inspect
+
+        if not isinstance(mapping, Mapping):
+            raise InputError(where, mapping, "must be a table")
+        two_mode = "a_jj" in mapping
+        if two_mode:
+            params = inspect.signature(cls.from_two_modes).parameters
+            allowed = list(params)
+            required = [k for k, p in params.items() if p.default is inspect.Parameter.empty]
+        else:
+            allowed = required = [f.name for f in fields(cls)]
+        for key in mapping:
+            if key not in allowed:
+                raise InputError(f"{where}.{key}", mapping[key], f"unknown key; allowed: {', '.join(allowed)}")
+        for key in required:
+            if key not in mapping:
+                raise InputError(f"{where}.{key}", None, "missing (required key)")
+        values = dict(mapping)
+        for key in ("labels", "kinds", "symmetries"):
+            if key in values:
+                if not isinstance(values[key], (list, tuple)) or not all(isinstance(s, str) for s in values[key]):
+                    raise InputError(f"{where}.{key}", values[key], "a list of strings")
+                values[key] = tuple(values[key])
+        try:
+            return cls.from_two_modes(**values) if two_mode else cls(**values)
+        except InputError as err:  # re-key to the caller's dotted path
+            key = err.key.replace("modal.", f"{where}.", 1) if err.key.startswith("modal.") else err.key
+            raise InputError(key, err.value, err.allowed) from None
+        except (TypeError, ValueError) as err:
+            raise InputError(where, str(err), "numbers and lists of numbers as documented") from None
