@@ -1,0 +1,25 @@
+"""2D incompressible laminar Navier-Stokes on Cartesian MAC grids with immersed rigid bodies.
+
+Public API: build a ``CartesianGrid``, a ``FlowConfig`` (with ``BoundaryConditions``), bodies
+(``ImmersedBody`` from a ``Polygon`` and a motion), then ``Simulation`` and ``run`` with monitors.
+Plug-in points for later issues: ``Simulation.nu`` (cell field nu + nu_t, written by a turbulence
+model before each step), the grid object (metrics), the Poisson solver object, body motions
+(anything with ``pose(t)``/``velocity(t)``). See docs/cfd.md.
+"""
+
+from .bodies import Polygon, box_deck, circle, flat_plate
+from .boundaries import BoundaryConditions
+from .grids import GHOST, CartesianGrid, stretched_faces
+from .immersed import ImmersedBody
+from .monitors import CFLMonitor, DivergenceMonitor, ForceHistory, NaNMonitor, max_divergence, run
+from .motion import HarmonicMotion, PrescribedMotion, Stationary, UniformTranslation
+from .precision import DTYPE
+from .pressure import PoissonSolver
+from .time_stepping import TIME_SCHEMES, FlowConfig, FlowDiverged, Simulation
+
+__all__ = [
+    "BoundaryConditions", "CartesianGrid", "CFLMonitor", "DivergenceMonitor", "DTYPE", "FlowConfig",
+    "FlowDiverged", "ForceHistory", "GHOST", "HarmonicMotion", "ImmersedBody", "NaNMonitor",
+    "PoissonSolver", "Polygon", "PrescribedMotion", "Simulation", "Stationary", "TIME_SCHEMES",
+    "UniformTranslation", "box_deck", "circle", "flat_plate", "max_divergence", "run", "stretched_faces",
+]

@@ -1,0 +1,114 @@
+"""Monitors: small objects the time loop calls after every step (PyFR-plugin style).
+
+Each monitor has ``__call__(sim)``; ``every`` sets how often it works. ``run`` is the loop.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from kernels import cfd as _k
+
+from .grids import GHOST
+from .launch import ROW0
+from .time_stepping import FlowDiverged, Simulation
+
+__all__ = ["ForceHistory", "CFLMonitor", "DivergenceMonitor", "NaNMonitor", "run", "max_divergence"]
+
+
+class ForceHistory:
+    """Records (t, F_x, F_y, M_z) of every body after every step."""
+
+    def __init__(self):
+        self.t, self.forces = [], []
+
+    def __call__(self, sim: Simulation):
+        self.t.append(sim.t)
+        self.forces.append(np.array(sim.last_force))
+
+    def array(self) -> tuple[np.ndarray, np.ndarray]:
+        """times (n,), forces (n, n_bodies, 3)."""
+        return np.array(self.t), np.array(self.forces)
+
+
+class CFLMonitor:
+    """Records the convective Courant number max(|u| dt/dx + |v| dt/dy) of the state."""
+
+    def __init__(self, every: int = 10, limit: float = 1.0):
+        self.every, self.limit, self.history = every, limit, []
+
+    def __call__(self, sim: Simulation):
+        if sim.n_steps % self.every:
+            return
+        u, v, _ = sim.interior()
+        dy = sim.grid.hy_faces()[GHOST:GHOST + sim.grid.ny + 1][:, None]
+        dt = sim.last_dt
+        c = float(np.abs(u).max() * dt / sim.grid.dx + (np.abs(v) / dy).max() * dt)
+        self.history.append((sim.t, c))
+        if c > self.limit:
+            raise FlowDiverged(f"CFL {c:.3g} > {self.limit} at t={sim.t:.6g} (step {sim.n_steps})")
+
+
+def max_divergence(sim: Simulation) -> float:
+    """max |D u| over the cells of the current state (uses the solver's rhs scratch array)."""
+    g = GHOST
+    sim.L.rows(_k.divergence, sim.grid.ny, 0, [sim.u, sim.v, sim.hy_c, sim.grid.dx, 1.0, g, sim.grid.nx,
+                                              ROW0, sim.rhs])
+    return float(np.abs(sim.rhs.numpy()).max())
+
+
+class DivergenceMonitor:
+    """Records max |div u| (scaled by h / U_ref it is the relative mass error per cell)."""
+
+    def __init__(self, every: int = 50):
+        self.every, self.history = every, []
+
+    def __call__(self, sim: Simulation):
+        if sim.n_steps % self.every == 0:
+            self.history.append((sim.t, max_divergence(sim)))
+
+
+class NaNMonitor:
+    """Stops the run on a non-finite velocity: restores the last good state (checked every
+    ``every`` steps, copies kept on the host) and raises ``FlowDiverged`` with where and when."""
+
+    def __init__(self, every: int = 20):
+        self.every = every
+        self.good = None
+
+    def __call__(self, sim: Simulation):
+        if sim.n_steps % self.every:
+            return
+        arrays = {name: getattr(sim, name).numpy() for name in ("u", "v", "p")}
+        bad = [name for name, a in arrays.items() if not np.isfinite(a).all()]
+        if not bad:
+            self.good = (sim.t, sim.n_steps, {k: a.copy() for k, a in arrays.items()})
+            return
+        where = np.argwhere(~np.isfinite(arrays[bad[0]]))[0]
+        msg = (f"non-finite {bad} at t={sim.t:.6g} (step {sim.n_steps}), first at storage index "
+               f"{tuple(int(w) for w in where)}")
+        if self.good is not None:
+            t, n, saved = self.good
+            for k, a in saved.items():
+                getattr(sim, k).assign(a)
+            sim.t, sim.n_steps = t, n
+            msg += f"; state restored to the last good one at t={t:.6g} (step {n})"
+        raise FlowDiverged(msg)
+
+
+def run(sim: Simulation, t_end: float, monitors=(), max_steps: int | None = None) -> Simulation:
+    """Advance ``sim`` to ``t_end`` (last step shortened to land on it), calling the monitors."""
+    n = 0
+    while sim.t < t_end - 1e-12 * max(1.0, abs(t_end)):
+        dt = min(sim.stable_dt(), t_end - sim.t)
+        sim.last_dt = sim.step(dt)
+        n += 1
+        for m in monitors:
+            m(sim)
+        if max_steps is not None and n >= max_steps:
+            break
+    if not math.isfinite(sim.t):
+        raise FlowDiverged("time became non-finite")
+    return sim

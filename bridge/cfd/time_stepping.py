@@ -1,0 +1,210 @@
+"""Projection-method time stepping for 2D incompressible Navier-Stokes, assembled from parts.
+
+Equations: du/dt + div(u u) = -grad p + div(nu_eff (grad u + grad u^T)), div u = 0, with
+nu_eff(x, y) = nu + nu_t a cell-centred field (``Simulation.nu``; a turbulence model writes it).
+Each stage of an explicit SSP Runge-Kutta method (Shu and Osher 1988; "heun" is second order) is an
+incremental pressure-correction step (van Kan 1986):
+  u* = a u^n + b (u_k + dt (A(u_k) + D(u_k) - G p))     predictor (kernels predict_u / predict_v)
+  u* on the boundary faces (inflow, convective outflow), then direct forcing by the body
+  D G phi = D u* / (b dt)                                 direct Poisson solve (pressure.py)
+  u_{k+1} = u* - b dt G phi,   p <- p + phi               projection (kernel project)
+State arrays are preallocated and mutated in place: stage 1 writes the stage buffers (u_k), the last
+stage overwrites the state (u); ``u_star`` is scratch. Ghosts are refreshed after every projection.
+
+Parts are swappable: the grid (object with metrics), the advection scheme (registry), the Poisson
+solver (any object with ``solve(rhs, out)``), the bodies (objects with ``update/apply/force``),
+``nu`` (field), and the time scheme (registry of Shu-Osher coefficients).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import warp as wp
+
+from kernels import cfd as _k
+
+from .advection import scheme_code
+from .boundaries import BoundaryConditions, BoundaryOperator
+from .grids import GHOST, CartesianGrid
+from .launch import ROW0, RowLauncher
+from .precision import DTYPE, WP_DTYPE
+from .pressure import PoissonSolver
+
+__all__ = ["FlowConfig", "Simulation", "TIME_SCHEMES", "FlowDiverged"]
+
+# Shu-Osher form: stage k: u_{k+1} = a_k u^n + b_k (u_k + dt L(u_k)).
+TIME_SCHEMES = {
+    "euler": ((0.0, 1.0),),
+    "heun": ((0.0, 1.0), (0.5, 0.5)),  # SSP-RK2, second order
+}
+
+
+class FlowDiverged(RuntimeError):
+    """Raised by a monitor when the solution stops being finite."""
+
+
+@dataclass(frozen=True)
+class FlowConfig:
+    """Physical and numerical parameters (kinematic units; forces are scaled by ``rho``)."""
+
+    nu: float
+    rho: float = 1.0
+    advection: str = "vanleer"
+    time_scheme: str = "heun"
+    cfl: float = 0.4
+    fourier: float = 0.2  # viscous limit dt <= fourier * h_min^2 / nu_max
+    dt: float | None = None  # fixed step; None: from cfl and fourier
+    dt_max: float = np.inf
+    bc: BoundaryConditions = field(default_factory=BoundaryConditions)
+    threads: int = 2
+
+    def __post_init__(self):
+        if not self.nu > 0:
+            raise ValueError(f"nu: must be > 0, got {self.nu}")
+        if not self.rho > 0:
+            raise ValueError(f"rho: must be > 0, got {self.rho}")
+        scheme_code(self.advection)
+        if self.time_scheme not in TIME_SCHEMES:
+            raise ValueError(f"time_scheme: {self.time_scheme!r} unknown; allowed {sorted(TIME_SCHEMES)}")
+        if not 0 < self.cfl <= 1.0:
+            raise ValueError(f"cfl: allowed (0, 1], got {self.cfl}")
+        if not 0 < self.fourier <= 0.25:
+            raise ValueError(f"fourier: allowed (0, 0.25], got {self.fourier}")
+        if self.dt is not None and not self.dt > 0:
+            raise ValueError(f"dt: must be > 0 or None, got {self.dt}")
+        if self.threads < 1:
+            raise ValueError(f"threads: must be >= 1, got {self.threads}")
+
+
+class Simulation:
+    """Solver state on one grid plus the step assembled from its parts.
+
+    Public arrays (Warp, storage layout of ``grids``): ``u``, ``v``, ``p``, ``nu``. ``step(dt)``
+    advances them in place by one time step; ``t`` is the time of the state.
+    """
+
+    def __init__(self, grid: CartesianGrid, config: FlowConfig, bodies=(), device: str | None = None,
+                 poisson=None):
+        self.grid, self.config = grid, config
+        self.L = RowLauncher(device, config.threads)
+        dev = self.L.device
+        g, nx, ny = GHOST, grid.nx, grid.ny
+        self.bc = BoundaryOperator(config.bc, grid, self.L)
+        self.poisson = poisson if poisson is not None else PoissonSolver(grid)
+        self.scheme = scheme_code(config.advection)
+        self.stages = TIME_SCHEMES[config.time_scheme]
+        self.bodies = list(bodies)
+
+        def z(shape):
+            return wp.zeros(shape, dtype=WP_DTYPE, device=dev)
+
+        ushape, vshape, pshape = (ny + 2 * g, nx + 1 + 2 * g), (ny + 1 + 2 * g, nx + 2 * g), (ny + 2 * g, nx + 2 * g)
+        self.u, self.v, self.p = z(ushape), z(vshape), z(pshape)
+        self.u_stage, self.v_stage = z(ushape), z(vshape)
+        self.u_star, self.v_star = z(ushape), z(vshape)
+        self.nu = wp.full(pshape, config.nu, dtype=WP_DTYPE, device=dev)
+        self.rhs, self.phi = z((ny, nx)), z((ny, nx))
+        self.hy_c = wp.array(grid.hy_cells(), dtype=WP_DTYPE, device=dev)
+        self.hy_f = wp.array(grid.hy_faces(), dtype=WP_DTYPE, device=dev)
+        self._host = dev.is_cpu
+        if self._host:  # zero-copy views for the FFT solve
+            self._rhs_np, self._phi_np = self.rhs.numpy(), self.phi.numpy()
+        self.t = 0.0
+        self.n_steps = 0
+        self.last_force = [np.zeros(3) for _ in self.bodies]
+        self.nu_max = config.nu
+        self.last_dt = 0.0
+
+    # --- initialisation ---------------------------------------------------------------------------
+    def set_state(self, u=None, v=None, p=None, t: float = 0.0):
+        """Set the interior/boundary faces from (ny, nx+1), (ny+1, nx), (ny, nx) arrays or scalars."""
+        g, nx, ny = GHOST, self.grid.nx, self.grid.ny
+        for arr, val, sl in ((self.u, u, (slice(g, g + ny), slice(g, g + nx + 1))),
+                             (self.v, v, (slice(g, g + ny + 1), slice(g, g + nx))),
+                             (self.p, p, (slice(g, g + ny), slice(g, g + nx)))):
+            if val is None:
+                continue
+            host = arr.numpy()
+            host[sl] = val
+            arr.assign(host)
+        self.t = float(t)
+        self.bc.initial_normal_faces(self.u, self.t)
+        self._zero_wall_normals(self.v)
+        self.bc.fill_ghosts(self.u, self.v)
+
+    def _zero_wall_normals(self, v):
+        g, ny = GHOST, self.grid.ny
+        host = v.numpy()
+        host[g, :] = 0.0
+        host[g + ny, :] = 0.0
+        if self.config.bc.left == "slip":
+            hu = self.u.numpy()
+            hu[:, g] = 0.0
+            hu[:, g + self.grid.nx] = 0.0
+            self.u.assign(hu)
+        v.assign(host)
+
+    def interior(self):
+        """NumPy copies (u (ny, nx+1), v (ny+1, nx), p (ny, nx)) without ghosts."""
+        g, nx, ny = GHOST, self.grid.nx, self.grid.ny
+        return (self.u.numpy()[g:g + ny, g:g + nx + 1].copy(), self.v.numpy()[g:g + ny + 1, g:g + nx].copy(),
+                self.p.numpy()[g:g + ny, g:g + nx].copy())
+
+    # --- time step ---------------------------------------------------------------------------------
+    def stable_dt(self) -> float:
+        """dt from the CFL number and the viscous (Fourier) limit; the fixed dt if configured."""
+        c = self.config
+        if c.dt is not None:
+            return c.dt
+        ui, vi, _ = self.interior()
+        h = self.grid.min_spacing
+        rate = np.abs(ui).max() / self.grid.dx + (np.abs(vi[1:-1]) / self.grid.hy_faces()[GHOST + 1:GHOST + self.grid.ny][:, None]).max()
+        dt_visc = c.fourier * h * h / self.nu_max
+        dt_conv = c.cfl / rate if rate > 0 else np.inf
+        return float(min(dt_visc, dt_conv, c.dt_max))
+
+    def _predict(self, src_u, src_v, u0, v0, dt, a, b):
+        g, nx, ny = GHOST, self.grid.nx, self.grid.ny
+        dx, s = self.grid.dx, self.scheme
+        self.L.rows(_k.predict_u, ny, g, [src_u, src_v, self.p, self.nu, u0, self.u_star, self.hy_c,
+                                          self.hy_f, dx, dt, a, b, g + 1, g + nx, ROW0, s])
+        self.L.rows(_k.predict_v, ny - 1, g + 1, [src_u, src_v, self.p, self.nu, v0, self.v_star, self.hy_c,
+                                                  self.hy_f, dx, dt, a, b, g, g + nx, ROW0, s])
+
+    def _project(self, dst_u, dst_v, c):
+        g, nx, ny = GHOST, self.grid.nx, self.grid.ny
+        self.L.rows(_k.divergence, ny, 0, [self.u_star, self.v_star, self.hy_c, self.grid.dx, 1.0 / c,
+                                           g, nx, ROW0, self.rhs])
+        if self._host:
+            self.poisson.solve(self._rhs_np, out=self._phi_np)
+        else:
+            self.phi.assign(self.poisson.solve(self.rhs.numpy()))
+        self.L.rows(_k.project, ny, 0, [self.u_star, self.v_star, self.phi, self.hy_f, self.grid.dx, c,
+                                        g, nx, ny, ROW0, dst_u, dst_v, self.p])
+
+    def step(self, dt: float | None = None) -> float:
+        """Advance the state by one step (in place); returns the dt used."""
+        dt = self.stable_dt() if dt is None else float(dt)
+        t_new = self.t + dt
+        for body in self.bodies:
+            body.update(t_new)
+            body.reset_impulse()
+        src_u, src_v = self.u, self.v
+        n = len(self.stages)
+        for k, (a, b) in enumerate(self.stages):
+            last = k == n - 1
+            dst_u, dst_v = (self.u, self.v) if last else (self.u_stage, self.v_stage)
+            self._predict(src_u, src_v, self.u, self.v, dt, a, b)
+            self.bc.set_normal_faces(self.u, src_u, self.u_star, t_new, dt, a, b)
+            for body in self.bodies:
+                body.apply(self.u_star, self.v_star, k)
+            self._project(dst_u, dst_v, b * dt)
+            self.bc.fill_ghosts(dst_u, dst_v)
+            src_u, src_v = dst_u, dst_v
+        weights = [float(np.prod([bb for _, bb in self.stages[k + 1:]])) for k in range(n)]
+        self.last_force = [body.force(weights, dt, self.t, t_new, self.config.rho) for body in self.bodies]
+        self.t = t_new
+        self.n_steps += 1
+        return dt

@@ -1,0 +1,427 @@
+"""Warp kernels of the 2D incompressible Navier-Stokes solver (staggered MAC grid).
+
+Only pointwise maths (``@wp.func``) and thin row kernels live here; ``bridge.cfd`` launches them.
+
+Storage convention (see ``bridge.cfd.grids``): arrays are indexed ``[J, I]`` (row = y) with ``G``
+ghost layers; cell (i, j) is stored at (J, I) = (j + G, i + G); the u-face at storage (J, I) is the
+LEFT face of cell column I; the v-face at storage (J, I) is the BOTTOM face of cell row J.
+
+Kernel shape: one thread per row with an inner loop over the columns (2x faster on the CPU backend
+than a 2D ``wp.tid()``; see WARP_CPU.md); ``row0`` lets the launcher split the rows over threads.
+Every kernel also runs unchanged on "cuda" (one thread per row there too).
+
+Kernels are typed for float64 (the project's CFD precision, ``bridge.cfd.precision``).
+"""
+
+import warp as wp
+
+# Advection schemes (integer codes used inside kernels; names in bridge.cfd.advection).
+SCHEME_CENTRAL = 0
+SCHEME_VANLEER = 1
+
+# IB face states.
+IB_FLUID = 0
+IB_SOLID = 1
+IB_INTERFACE = 2
+
+
+@wp.func
+def limited_face_value(q_u: wp.float64, q_c: wp.float64, q_d: wp.float64,
+                       d_uc: wp.float64, d_cd: wp.float64, w_cf: wp.float64, scheme: int):
+    """Face value from the upwind cell C towards downwind D (MUSCL form).
+
+    q_f = q_c + psi(r) w_cf (q_d - q_c), r = ((q_c - q_u)/d_uc) / ((q_d - q_c)/d_cd),
+    w_cf = distance C->face / distance C->D (1/2 on a uniform grid).
+    central: psi = 1 (linear interpolation, second order); vanleer: psi = (r + |r|)/(1 + |r|)
+    (TVD, second order where smooth, monotone at extrema).
+    """
+    dq = q_d - q_c
+    if scheme == 0:
+        return q_c + w_cf * dq
+    num = (q_c - q_u) * d_cd
+    den = dq * d_uc
+    psi = wp.float64(0.0)
+    if num * den > wp.float64(0.0):
+        r = num / den
+        psi = (r + wp.abs(r)) / (wp.float64(1.0) + wp.abs(r))
+    return q_c + psi * w_cf * dq
+
+
+@wp.func
+def upwind_flux(vel: wp.float64, q_m2: wp.float64, q_m1: wp.float64, q_p1: wp.float64, q_p2: wp.float64,
+                d_m: wp.float64, d_0: wp.float64, d_p: wp.float64, w_m: wp.float64, scheme: int):
+    """Advective flux vel*q at a face between points m1 (behind) and p1 (ahead).
+
+    d_m, d_0, d_p: spacings m2-m1, m1-p1, p1-p2; w_m: distance m1->face / d_0.
+    """
+    q = wp.float64(0.0)
+    if vel >= wp.float64(0.0):
+        q = limited_face_value(q_m2, q_m1, q_p1, d_m, d_0, w_m, scheme)
+    else:
+        q = limited_face_value(q_p2, q_p1, q_m1, d_p, d_0, wp.float64(1.0) - w_m, scheme)
+    return vel * q
+
+
+@wp.kernel
+def predict_u(u: wp.array2d(dtype=wp.float64), v: wp.array2d(dtype=wp.float64),
+              p: wp.array2d(dtype=wp.float64), nu: wp.array2d(dtype=wp.float64),
+              u0: wp.array2d(dtype=wp.float64), out: wp.array2d(dtype=wp.float64),
+              hy_c: wp.array(dtype=wp.float64), hy_f: wp.array(dtype=wp.float64),
+              dx: wp.float64, dt: wp.float64, a: wp.float64, b: wp.float64,
+              i_lo: int, i_hi: int, row0: int, scheme: int):
+    """out = a*u0 + b*(u + dt*(-div(u u) + div(2 nu S)_x - dp/dx)) on u-faces of one row.
+
+    Conservative advection (limited upwind-biased) and the full variable-viscosity stress
+    nu (grad u + grad u^T) so an eddy viscosity nu_t(x, y) plugs in through ``nu``.
+    """
+    J = row0 + wp.tid()
+    half = wp.float64(0.5)
+    two = wp.float64(2.0)
+    hc = hy_c[J]
+    # x-flux at the cell centre left of face I (cell column I-1), carried along the row.
+    I = i_lo
+    uc = half * (u[J, I - 1] + u[J, I])
+    fl = upwind_flux(uc, u[J, I - 2], u[J, I - 1], u[J, I], u[J, I + 1], dx, dx, dx, half, scheme) \
+        - two * nu[J, I - 1] * (u[J, I] - u[J, I - 1]) / dx
+    for I in range(i_lo, i_hi):
+        uc = half * (u[J, I] + u[J, I + 1])
+        fr = upwind_flux(uc, u[J, I - 1], u[J, I], u[J, I + 1], u[J, I + 2], dx, dx, dx, half, scheme) \
+            - two * nu[J, I] * (u[J, I + 1] - u[J, I]) / dx
+        # y-fluxes at the corners on v-face rows J+1 (top) and J (bottom).
+        vt = half * (v[J + 1, I - 1] + v[J + 1, I])
+        nut = wp.float64(0.25) * (nu[J, I - 1] + nu[J, I] + nu[J + 1, I - 1] + nu[J + 1, I])
+        gt = upwind_flux(vt, u[J - 1, I], u[J, I], u[J + 1, I], u[J + 2, I],
+                         hy_f[J], hy_f[J + 1], hy_f[J + 2], half * hy_c[J] / hy_f[J + 1], scheme) \
+            - nut * ((u[J + 1, I] - u[J, I]) / hy_f[J + 1] + (v[J + 1, I] - v[J + 1, I - 1]) / dx)
+        vb = half * (v[J, I - 1] + v[J, I])
+        nub = wp.float64(0.25) * (nu[J - 1, I - 1] + nu[J - 1, I] + nu[J, I - 1] + nu[J, I])
+        gb = upwind_flux(vb, u[J - 2, I], u[J - 1, I], u[J, I], u[J + 1, I],
+                         hy_f[J - 1], hy_f[J], hy_f[J + 1], half * hy_c[J - 1] / hy_f[J], scheme) \
+            - nub * ((u[J, I] - u[J - 1, I]) / hy_f[J] + (v[J, I] - v[J, I - 1]) / dx)
+        rhs = -(fr - fl) / dx - (gt - gb) / hc - (p[J, I] - p[J, I - 1]) / dx
+        out[J, I] = a * u0[J, I] + b * (u[J, I] + dt * rhs)
+        fl = fr
+
+
+@wp.kernel
+def predict_v(u: wp.array2d(dtype=wp.float64), v: wp.array2d(dtype=wp.float64),
+              p: wp.array2d(dtype=wp.float64), nu: wp.array2d(dtype=wp.float64),
+              v0: wp.array2d(dtype=wp.float64), out: wp.array2d(dtype=wp.float64),
+              hy_c: wp.array(dtype=wp.float64), hy_f: wp.array(dtype=wp.float64),
+              dx: wp.float64, dt: wp.float64, a: wp.float64, b: wp.float64,
+              i_lo: int, i_hi: int, row0: int, scheme: int):
+    """out = a*v0 + b*(v + dt*(-div(v u) + div(2 nu S)_y - dp/dy)) on v-faces of one row."""
+    J = row0 + wp.tid()
+    half = wp.float64(0.5)
+    two = wp.float64(2.0)
+    hf = hy_f[J]
+    # weights of u rows J-1 and J at the corner height (face row J)
+    wl = half * hy_c[J] / hf
+    wu = half * hy_c[J - 1] / hf
+    I = i_lo
+    ucl = wl * u[J - 1, I] + wu * u[J, I]
+    nul = wp.float64(0.25) * (nu[J - 1, I - 1] + nu[J - 1, I] + nu[J, I - 1] + nu[J, I])
+    fl = upwind_flux(ucl, v[J, I - 2], v[J, I - 1], v[J, I], v[J, I + 1], dx, dx, dx, half, scheme) \
+        - nul * ((v[J, I] - v[J, I - 1]) / dx + (u[J, I] - u[J - 1, I]) / hf)
+    for I in range(i_lo, i_hi):
+        ucr = wl * u[J - 1, I + 1] + wu * u[J, I + 1]
+        nur = wp.float64(0.25) * (nu[J - 1, I] + nu[J - 1, I + 1] + nu[J, I] + nu[J, I + 1])
+        fr = upwind_flux(ucr, v[J, I - 1], v[J, I], v[J, I + 1], v[J, I + 2], dx, dx, dx, half, scheme) \
+            - nur * ((v[J, I + 1] - v[J, I]) / dx + (u[J, I + 1] - u[J - 1, I + 1]) / hf)
+        # y-fluxes at cell centres of rows J (top) and J-1 (bottom)
+        vt = half * (v[J, I] + v[J + 1, I])
+        gt = upwind_flux(vt, v[J - 1, I], v[J, I], v[J + 1, I], v[J + 2, I],
+                         hy_c[J - 1], hy_c[J], hy_c[J + 1], half, scheme) \
+            - two * nu[J, I] * (v[J + 1, I] - v[J, I]) / hy_c[J]
+        vb = half * (v[J - 1, I] + v[J, I])
+        gb = upwind_flux(vb, v[J - 2, I], v[J - 1, I], v[J, I], v[J + 1, I],
+                         hy_c[J - 2], hy_c[J - 1], hy_c[J], half, scheme) \
+            - two * nu[J - 1, I] * (v[J, I] - v[J - 1, I]) / hy_c[J - 1]
+        rhs = -(fr - fl) / dx - (gt - gb) / hf - (p[J, I] - p[J - 1, I]) / hf
+        out[J, I] = a * v0[J, I] + b * (v[J, I] + dt * rhs)
+        fl = fr
+
+
+@wp.kernel
+def divergence(u: wp.array2d(dtype=wp.float64), v: wp.array2d(dtype=wp.float64),
+               hy_c: wp.array(dtype=wp.float64), dx: wp.float64, scale: wp.float64, g: int, nx: int,
+               row0: int, div: wp.array2d(dtype=wp.float64)):
+    """div[j, i] = scale * (D u)_cell, interior cells only (no ghosts in ``div``)."""
+    j = row0 + wp.tid()
+    J = j + g
+    for i in range(nx):
+        I = i + g
+        div[j, i] = scale * ((u[J, I + 1] - u[J, I]) / dx + (v[J + 1, I] - v[J, I]) / hy_c[J])
+
+
+@wp.kernel
+def project(ustar: wp.array2d(dtype=wp.float64), vstar: wp.array2d(dtype=wp.float64),
+            phi: wp.array2d(dtype=wp.float64), hy_f: wp.array(dtype=wp.float64),
+            dx: wp.float64, c: wp.float64, g: int, nx: int, ny: int, row0: int,
+            u: wp.array2d(dtype=wp.float64), v: wp.array2d(dtype=wp.float64),
+            p: wp.array2d(dtype=wp.float64)):
+    """u = u* - c grad(phi) on interior faces (boundary faces copied), p += phi; one cell row."""
+    j = row0 + wp.tid()
+    J = j + g
+    for i in range(nx + 1):
+        I = i + g
+        if i == 0 or i == nx:
+            u[J, I] = ustar[J, I]
+        else:
+            u[J, I] = ustar[J, I] - c * (phi[j, i] - phi[j, i - 1]) / dx
+        if i < nx:
+            if j == 0:
+                v[J, I] = vstar[J, I]
+            else:
+                v[J, I] = vstar[J, I] - c * (phi[j, i] - phi[j - 1, i]) / hy_f[J]
+            p[J, I] = p[J, I] + phi[j, i]
+    if j == ny - 1:
+        for i in range(nx):
+            v[J + 1, i + g] = vstar[J + 1, i + g]
+
+
+# ----------------------------------------------------------------------------- boundary conditions
+# Side codes: 0 slip (zero normal velocity, zero tangential gradient), 1 no-slip wall,
+# 2 inflow (Dirichlet, left only), 3 convective outflow (right only), 4 given (face values kept).
+
+@wp.kernel
+def bc_y_sides(u: wp.array2d(dtype=wp.float64), v: wp.array2d(dtype=wp.float64),
+               g: int, nx: int, ny: int, bottom: int, top: int):
+    """Ghost rows at bottom and top for every storage column; normal v-faces on the walls = 0."""
+    I = wp.tid()
+    jb = g  # first interior row
+    jt = g + ny - 1
+    for k in range(1, g + 1):
+        # u ghosts: mirror (slip) or antisymmetric (no-slip)
+        if I < u.shape[1]:
+            if bottom == 1:
+                u[jb - k, I] = -u[jb + k - 1, I]
+            else:
+                u[jb - k, I] = u[jb + k - 1, I]
+            if top == 1:
+                u[jt + k, I] = -u[jt - k + 1, I]
+            else:
+                u[jt + k, I] = u[jt - k + 1, I]
+        if I < v.shape[1]:
+            v[g - k, I] = -v[g + k, I]
+            v[g + ny + k, I] = -v[g + ny - k, I]
+    if I < v.shape[1]:
+        v[g, I] = wp.float64(0.0)
+        v[g + ny, I] = wp.float64(0.0)
+
+
+@wp.kernel
+def bc_x_sides(u: wp.array2d(dtype=wp.float64), v: wp.array2d(dtype=wp.float64),
+               g: int, nx: int, left: int, right: int):
+    """Ghost columns at left and right for every storage row (normal u-faces set by the caller)."""
+    J = wp.tid()
+    il = g
+    ir = g + nx
+    for k in range(1, g + 1):
+        if J < u.shape[0]:
+            if left == 0:  # slip wall: antisymmetric normal velocity about the wall face
+                u[J, il - k] = -u[J, il + k]
+            else:  # inflow: constant extrapolation of the prescribed face value
+                u[J, il - k] = u[J, il]
+            if right == 0:
+                u[J, ir + k] = -u[J, ir - k]
+            else:  # outflow: zero-gradient continuation
+                u[J, ir + k] = u[J, ir]
+        if J < v.shape[0]:
+            # tangential velocity: mirror at slip walls and outflow, v = 0 at the inflow
+            if left == 2 or left == 1:
+                v[J, il - k] = -v[J, il + k - 1]
+            else:
+                v[J, il - k] = v[J, il + k - 1]
+            if right == 1:
+                v[J, ir + k - 1] = -v[J, ir - k]
+            else:
+                v[J, ir + k - 1] = v[J, ir - k]
+
+
+@wp.kernel
+def set_inflow(u: wp.array2d(dtype=wp.float64), profile: wp.array(dtype=wp.float64), g: int):
+    """u on the left boundary faces = profile[j]."""
+    j = wp.tid()
+    u[j + g, g] = profile[j]
+
+
+@wp.kernel
+def convective_outflow(u0: wp.array2d(dtype=wp.float64), u: wp.array2d(dtype=wp.float64),
+                       out: wp.array2d(dtype=wp.float64), dx: wp.float64, dt: wp.float64,
+                       a: wp.float64, b: wp.float64, speed: wp.float64, g: int, nx: int):
+    """du/dt + U_c du/dx = 0 on the right boundary faces, same RK stage form as the interior."""
+    j = wp.tid()
+    J = j + g
+    I = g + nx
+    out[J, I] = a * u0[J, I] + b * (u[J, I] - dt * speed * (u[J, I] - u[J, I - 1]) / dx)
+
+
+@wp.kernel
+def boundary_fluxes(u: wp.array2d(dtype=wp.float64), hy_c: wp.array(dtype=wp.float64), g: int, nx: int,
+                    flux: wp.array(dtype=wp.float64)):
+    """flux[0] += inflow volume flux, flux[1] += outflow volume flux (per row, atomic)."""
+    j = wp.tid()
+    J = j + g
+    wp.atomic_add(flux, 0, u[J, g] * hy_c[J])
+    wp.atomic_add(flux, 1, u[J, g + nx] * hy_c[J])
+
+
+@wp.kernel
+def shift_outflow(u: wp.array2d(dtype=wp.float64), delta: wp.float64, g: int, nx: int):
+    """Add a uniform correction to the outflow faces so the volume flux balances."""
+    j = wp.tid()
+    u[j + g, g + nx] = u[j + g, g + nx] + delta
+
+
+# ----------------------------------------------------------------------------- immersed boundary
+
+@wp.func
+def polygon_signed_distance(px: wp.float64, py: wp.float64, verts: wp.array(dtype=wp.vec2d)):
+    """Signed distance from (px, py) to a closed polygon (negative inside; even-odd rule)."""
+    n = verts.shape[0]
+    dmin = wp.float64(1.0e300)
+    inside = int(0)
+    for k in range(n):
+        a = verts[k]
+        b = verts[(k + 1) % n]
+        ex = b[0] - a[0]
+        ey = b[1] - a[1]
+        wx = px - a[0]
+        wy = py - a[1]
+        t = wp.clamp((wx * ex + wy * ey) / (ex * ex + ey * ey), wp.float64(0.0), wp.float64(1.0))
+        dx = wx - t * ex
+        dy = wy - t * ey
+        dmin = wp.min(dmin, dx * dx + dy * dy)
+        if (a[1] > py) != (b[1] > py):
+            xc = a[0] + (py - a[1]) * ex / ey
+            if px < xc:
+                inside = 1 - inside
+    d = wp.sqrt(dmin)
+    if inside == 1:
+        d = -d
+    return d
+
+
+@wp.kernel
+def ib_level_set(verts: wp.array(dtype=wp.vec2d), x0: wp.float64, dx: wp.float64, xoff: wp.float64,
+                 yc: wp.array(dtype=wp.float64), pos: wp.vec3d, i0: int, j0: int, ni: int,
+                 phi: wp.array2d(dtype=wp.float64)):
+    """phi[jb, ib] = signed distance of the face (I = i0 + ib, J = j0 + jb) to the moved polygon.
+
+    Face x = x0 + (I + xoff) dx, face y = yc[J]; pos = (x_ref, y_ref, theta) of the body frame.
+    """
+    jb = wp.tid()
+    c = wp.cos(pos[2])
+    s = wp.sin(pos[2])
+    for ib in range(ni):
+        X = x0 + (wp.float64(i0 + ib) + xoff) * dx - pos[0]
+        Y = yc[j0 + jb] - pos[1]
+        # rotate into the body frame
+        phi[jb, ib] = polygon_signed_distance(c * X + s * Y, -s * X + c * Y, verts)
+
+
+@wp.func
+def rigid_velocity(x: wp.float64, y: wp.float64, pos: wp.vec3d, vel: wp.vec3d, comp: int):
+    """Component comp (0: u, 1: v) of u_ref + omega x (r - r_ref)."""
+    if comp == 0:
+        return vel[0] - vel[2] * (y - pos[1])
+    return vel[1] + vel[2] * (x - pos[0])
+
+
+@wp.kernel
+def ib_targets(q: wp.array2d(dtype=wp.float64), phi: wp.array2d(dtype=wp.float64),
+               x0: wp.float64, dx: wp.float64, xoff: wp.float64, yc: wp.array(dtype=wp.float64),
+               pos: wp.vec3d, vel: wp.vec3d, comp: int, i0: int, j0: int, ni: int,
+               ilo: int, ihi: int, jlo: int, jhi: int,
+               target: wp.array2d(dtype=wp.float64), state: wp.array2d(dtype=wp.int32)):
+    """Direct-forcing target of each face in the box (state: 0 fluid, 1 solid, 2 interface).
+
+    Solid faces (phi <= 0) take the rigid-body velocity. Fluid faces with a solid neighbour along a
+    grid line take the linear interpolation (Fadlun et al. 2000) between the body velocity at the
+    interface point (distance d found from phi along the line) and the next fluid face:
+    q_f = q_b + (q_o - q_b) d / (d + h); estimates from several lines are averaged.
+    Only faces with ilo <= I < ihi and jlo <= J < jhi are updated (boundary faces excluded);
+    reads ``q`` and writes ``target``/``state`` only, so the result does not depend on order.
+    """
+    jb = wp.tid()
+    J = j0 + jb
+    for ib in range(ni):
+        I = i0 + ib
+        st = int(0)
+        tg = wp.float64(0.0)
+        if ib > 0 and ib < ni - 1 and jb > 0 and jb < phi.shape[0] - 1 and I >= ilo and I < ihi \
+                and J >= jlo and J < jhi:
+            ph = phi[jb, ib]
+            x = x0 + (wp.float64(I) + xoff) * dx
+            y = yc[J]
+            if ph <= wp.float64(0.0):
+                st = 1
+                tg = rigid_velocity(x, y, pos, vel, comp)
+            else:
+                acc = wp.float64(0.0)
+                cnt = wp.float64(0.0)
+                for k in range(4):
+                    di = int(0)
+                    dj = int(0)
+                    h = wp.float64(dx)
+                    if k == 0:
+                        di = -1
+                    elif k == 1:
+                        di = 1
+                    elif k == 2:
+                        dj = -1
+                        h = yc[J] - yc[J - 1]
+                    else:
+                        dj = 1
+                        h = yc[J + 1] - yc[J]
+                    pn = phi[jb + dj, ib + di]
+                    if pn <= wp.float64(0.0):
+                        d = h * ph / (ph - pn)  # distance face -> interface along the line
+                        xb = x + wp.float64(di) * d
+                        yb = y + wp.float64(dj) * d
+                        qb = rigid_velocity(xb, yb, pos, vel, comp)
+                        qo = q[J - dj, I - di]
+                        ho = h
+                        if dj != 0:
+                            ho = wp.abs(yc[J - dj] - yc[J])
+                        acc += qb + (qo - qb) * d / (d + ho)
+                        cnt += wp.float64(1.0)
+                if cnt > wp.float64(0.0):
+                    st = 2
+                    tg = acc / cnt
+        target[jb, ib] = tg
+        state[jb, ib] = st
+
+
+@wp.kernel
+def ib_apply(q: wp.array2d(dtype=wp.float64), target: wp.array2d(dtype=wp.float64),
+             state: wp.array2d(dtype=wp.int32), x0: wp.float64, dx: wp.float64, xoff: wp.float64,
+             yc: wp.array(dtype=wp.float64), hy: wp.array(dtype=wp.float64), pos: wp.vec3d,
+             comp: int, i0: int, j0: int, ni: int, slot: int, acc: wp.array(dtype=wp.float64)):
+    """q = target on forced faces; acc[3 slot + comp] += momentum added (per unit density),
+    acc[3 slot + 2] += its moment about pos[0:2]. ``hy`` is the face control-volume height."""
+    jb = wp.tid()
+    J = j0 + jb
+    mom = wp.float64(0.0)
+    mz = wp.float64(0.0)
+    for ib in range(ni):
+        if state[jb, ib] != 0:
+            I = i0 + ib
+            dq = (target[jb, ib] - q[J, I]) * dx * hy[J]
+            q[J, I] = target[jb, ib]
+            mom += dq
+            if comp == 0:
+                mz -= (yc[J] - pos[1]) * dq
+            else:
+                mz += (x0 + (wp.float64(I) + xoff) * dx - pos[0]) * dq
+    wp.atomic_add(acc, 3 * slot + comp, mom)
+    wp.atomic_add(acc, 3 * slot + 2, mz)
+
+
+@wp.kernel
+def fill_rows(q: wp.array2d(dtype=wp.float64), value: wp.float64):
+    """q[:, :] = value (row kernel)."""
+    J = wp.tid()
+    for I in range(q.shape[1]):
+        q[J, I] = value
