@@ -9,7 +9,7 @@ A_a = A_R + i A_I ~ A_R + (A_I / w) s, which is exact on the imaginary axis (s =
 is a real quadratic eigenvalue problem (state-space form, 2N eigenvalues); for each mode the trial w is
 replaced by Im(s) of the tracked eigenvalue until it no longer changes.  Damping ratio
 zeta = -Re(s) / |s|, frequency Im(s) / 2 pi.  Flutter: the first V where a damping ratio crosses zero
-(refined by Brent's method on zeta(V)).  At that point s = i w exactly, so with two modes the p-k
+(refined by Brent's method on zeta(V)); a crossing at zero frequency is static divergence, reported apart.  At that point s = i w exactly, so with two modes the p-k
 critical speed is the determinant method's (Eq 4.29) to the iteration tolerance.
 Lateral modes carry no aerodynamic FRF in the thesis's model and are left out.
 """
@@ -34,7 +34,10 @@ class MultimodeResult:
     """Frequencies and damping ratios of every mode against V, and the flutter onset.
 
     ``speed_m_s`` (n_V,), ``frequency_hz`` and ``damping_ratio`` (n_V, N) in the order of ``labels``.
-    ``flutter`` False: no damping ratio crossed zero up to ``max_speed_searched_m_s``.
+    ``flutter`` False: no damping ratio of an oscillating mode crossed zero up to ``max_speed_searched_m_s``.
+    A crossing where the mode's frequency has gone to zero is static (torsional) divergence, reported in
+    ``divergence_speed_m_s`` and not as flutter (the moment about mid-chord of a plate diverges at
+    (1/2) rho V^2 B^2 (pi/2) = J w_T^2, Eq 4.37 with h_mtheta(0) = pi/2).
     """
 
     labels: tuple[str, ...]
@@ -47,6 +50,7 @@ class MultimodeResult:
     reduced_frequency: float
     unstable_mode: str
     max_speed_searched_m_s: float
+    divergence_speed_m_s: float = np.nan   # lowest V where a mode's frequency went to zero (static), or NaN
 
 
 def _state_matrix(model: ModalModel, aero: AerodynamicModel, rho: float, w: float, V: float) -> np.ndarray:
@@ -117,16 +121,23 @@ def pk_sweep(model: ModalModel, aero: AerodynamicModel, air_density: float, max_
     result = dict(labels=model.labels, speed_m_s=speeds, frequency_hz=freq, damping_ratio=zeta,
                   max_speed_searched_m_s=float(v_hi))
     crossing = np.flatnonzero((zeta[:-1] > 0.0) & (zeta[1:] <= 0.0))  # flat index over (n_V-1, N)
-    if crossing.size == 0:
-        return MultimodeResult(flutter=False, critical_speed_m_s=np.nan, frequency_hz_at_flutter=np.nan,
-                               reduced_frequency=np.nan, unstable_mode="", **result)
-    n0, r = np.unravel_index(crossing.min(), (speeds.size - 1, model.n_modes))  # lowest V first
+    w_floor = 1e-3 * model.angular_frequencies.min()   # below this an unstable root is static: divergence
+    divergence = np.nan
+    for c in np.sort(crossing):                          # ascending V, then mode
+        n0, r = np.unravel_index(c, (speeds.size - 1, model.n_modes))
 
-    def zeta_r(V: float) -> float:
-        return float(_damping(aeroelastic_eigenvalues(model, aero, air_density, V, eig[n0], tolerance))[r])
+        def zeta_r(V: float, n0=n0, r=r) -> float:
+            return float(_damping(aeroelastic_eigenvalues(model, aero, air_density, V, eig[n0], tolerance))[r])
 
-    V_c = brentq(zeta_r, speeds[n0], speeds[n0 + 1], xtol=1e-12 * speeds[n0 + 1], rtol=1e-12)
-    s_c = aeroelastic_eigenvalues(model, aero, air_density, V_c, eig[n0], tolerance)[r]
-    return MultimodeResult(flutter=True, critical_speed_m_s=float(V_c), frequency_hz_at_flutter=float(s_c.imag / (2 * np.pi)),
-                           reduced_frequency=float(s_c.imag * model.deck_width_m / V_c),
-                           unstable_mode=model.labels[r], **result)
+        V_c = brentq(zeta_r, speeds[n0], speeds[n0 + 1], xtol=1e-12 * speeds[n0 + 1], rtol=1e-12)
+        s_c = aeroelastic_eigenvalues(model, aero, air_density, V_c, eig[n0], tolerance)[r]
+        if s_c.imag < w_floor:                             # zero frequency: static divergence, not flutter
+            if np.isnan(divergence):
+                divergence = float(V_c)
+            continue
+        return MultimodeResult(flutter=True, critical_speed_m_s=float(V_c),
+                               frequency_hz_at_flutter=float(s_c.imag / (2 * np.pi)),
+                               reduced_frequency=float(s_c.imag * model.deck_width_m / V_c),
+                               unstable_mode=model.labels[r], divergence_speed_m_s=divergence, **result)
+    return MultimodeResult(flutter=False, critical_speed_m_s=np.nan, frequency_hz_at_flutter=np.nan,
+                           reduced_frequency=np.nan, unstable_mode="", divergence_speed_m_s=divergence, **result)
