@@ -450,11 +450,32 @@ def scenario_path(name_or_path: str | Path) -> Path:
     return candidate
 
 
-def load_scenario(name_or_path: str | Path, main_span_m: float | None = None, _seen: tuple = ()) -> Scenario:
+def apply_overrides(data: dict, overrides: Mapping[str, Any]) -> dict:
+    """Set dotted keys (``"girder.mass_per_length_kg_m"``) in raw TOML data; the key must already exist
+    (a sweep cannot invent inputs), except inside tables the file leaves to defaults."""
+    import copy
+
+    data = copy.deepcopy(data)
+    for dotted, value in overrides.items():
+        parts = dotted.split(".")
+        node = data
+        for part in parts[:-1]:
+            if not isinstance(node, dict) or part not in node:
+                raise InputError(dotted, value, "no such scenario key to override")
+            node = node[part]
+        if not isinstance(node, dict) or parts[-1] not in node:
+            raise InputError(dotted, value, "no such scenario key to override")
+        node[parts[-1]] = value
+    return data
+
+
+def load_scenario(name_or_path: str | Path, main_span_m: float | None = None,
+                  overrides: Mapping[str, Any] | None = None, _seen: tuple = ()) -> Scenario:
     """Read, validate and (if the file names a reference) up-scale a scenario.
 
     ``main_span_m`` overrides the file's main span (command line ``--main-span``): the reference bridge
-    is then up-scaled to it with the rules of thesis 1.5.
+    is then up-scaled to it with the rules of thesis 1.5.  ``overrides`` sets dotted input keys before
+    validation (for sweeps); for an up-scaled bridge they apply to its reference bridge's inputs.
     """
     path = scenario_path(name_or_path)
     try:
@@ -462,6 +483,10 @@ def load_scenario(name_or_path: str | Path, main_span_m: float | None = None, _s
             data = tomllib.load(fh)
     except tomllib.TOMLDecodeError as err:
         raise InputError("scenario", str(path), f"is not valid TOML ({err})") from None
+    overrides = dict(overrides or {})
+    if "reference" not in data and overrides:
+        data = apply_overrides(data, overrides)
+        overrides = {}
     t = _Table(data, "")
     name = t.string("name", default=path.stem)
     description = t.string("description", default="")
@@ -472,7 +497,7 @@ def load_scenario(name_or_path: str | Path, main_span_m: float | None = None, _s
             raise InputError("reference", ref, "circular reference between scenario files")
         span = t.number("main_span_m")
         reference = load_scenario(path.parent / f"{ref}.toml" if (path.parent / f"{ref}.toml").exists() else ref,
-                                  _seen=_seen + (name,))
+                                  overrides=overrides, _seen=_seen + (name,))
         target = main_span_m if main_span_m is not None else span
         if main_span_m is not None and not math.isclose(main_span_m, span):
             name = f"{name}_L{main_span_m:g}"
