@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import numpy as np
-
 from .cable import CableSolution, solve_cables
 from .config import Scenario
 from .errors import InputError

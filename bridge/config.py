@@ -20,9 +20,10 @@ from __future__ import annotations
 
 import math
 import tomllib
+from collections.abc import Mapping
 from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any
 
 from .errors import InputError, check_range
 
@@ -75,7 +76,7 @@ class _Table:
             raise InputError(self.key(name), value, f"must be one of {', '.join(choices)}")
         return value
 
-    def table(self, name: str, default: Any = ...) -> "_Table":
+    def table(self, name: str, default: Any = ...) -> _Table:
         value = self.raw(name, default)
         return _Table(value, self.key(name))
 
@@ -147,7 +148,7 @@ class BoxSection:
         am, bm = self.a_m - self.t_m, self.b_m - self.t_m
         return 4.0 * (am * bm) ** 2 * self.t_m / (2.0 * (am + bm))
 
-    def scaled(self, factor: float) -> "BoxSection":
+    def scaled(self, factor: float) -> BoxSection:
         """All three dimensions times ``factor``: inertia scales as factor**4, area as factor**2."""
         return BoxSection(self.a_m * factor, self.b_m * factor, self.t_m * factor)
 
@@ -312,7 +313,7 @@ class Scenario:
     def material(self, name: str) -> Material:
         return self.materials[name]
 
-    def with_main_span(self, main_span_m: float) -> "Scenario":
+    def with_main_span(self, main_span_m: float) -> Scenario:
         from .upscaling import upscale  # local import: upscaling needs this module
 
         return upscale(self, main_span_m)

@@ -7,8 +7,8 @@ stages with their prerequisites, runs them in order, and hands every output to
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from pathlib import Path
-from typing import Iterable
 
 from .config import Scenario
 from .errors import InputError
@@ -54,8 +54,9 @@ def plan_stages(scenario: Scenario, requested: Iterable[str] | None) -> tuple[st
 
 
 def run_stages(scenario: Scenario, stages: Iterable[str] | None = None,
-               options: RunOptions = RunOptions()) -> dict[str, StageOutput]:
+               options: RunOptions | None = None) -> dict[str, StageOutput]:
     """Run the planned stages in memory and return their outputs (no files written)."""
+    options = options or RunOptions()
     outputs: dict[str, StageOutput] = {}
     for name in plan_stages(scenario, stages):
         outputs[name] = resolve_stage(name)(scenario, outputs, options)
@@ -63,7 +64,7 @@ def run_stages(scenario: Scenario, stages: Iterable[str] | None = None,
 
 
 def run_scenario(scenario: Scenario, out_dir: Path, stages: Iterable[str] | None = None,
-                 options: RunOptions = RunOptions()) -> tuple[Path, dict[str, StageOutput]]:
+                 options: RunOptions | None = None) -> tuple[Path, dict[str, StageOutput]]:
     """Run the stages and write ``out_dir/<scenario.name>/``; return that folder and the outputs."""
     outputs = run_stages(scenario, stages, options)
     folder = write_results(Path(out_dir), scenario, outputs)

@@ -11,9 +11,10 @@ import json
 import os
 import shutil
 import tempfile
-from datetime import datetime, timezone
+from collections.abc import Mapping
+from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any
 
 import h5py
 import numpy as np
@@ -27,7 +28,7 @@ __all__ = ["write_results", "write_dataset"]
 SCHEMA_VERSION = "1"
 
 
-def write_dataset(group: "h5py.Group", name: str, data: Any, unit: str = "", description: str = "") -> None:
+def write_dataset(group: h5py.Group, name: str, data: Any, unit: str = "", description: str = "") -> None:
     """Write one dataset with its ``unit`` and ``description`` attributes (strings become UTF-8)."""
     arr = np.asarray(data)
     if arr.dtype.kind in "UO":
@@ -56,7 +57,7 @@ def write_results(out_root: Path, scenario: Scenario, outputs: Mapping[str, Stag
     final = out_root / scenario.name
     tmp = Path(tempfile.mkdtemp(prefix=f".{scenario.name}.", suffix=".tmp", dir=out_root))
     try:
-        stamp = datetime.now(timezone.utc).isoformat(timespec="seconds")
+        stamp = datetime.now(UTC).isoformat(timespec="seconds")
         summary: dict[str, Any] = {"scenario.name": scenario.name, "scenario.kind": scenario.kind,
                                    "stages": list(outputs)}
         with h5py.File(tmp / "results.h5", "w") as h5:

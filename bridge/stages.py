@@ -9,9 +9,10 @@ Stages never write files themselves; :mod:`bridge.results` writes everything ato
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from importlib import import_module
-from typing import Any, Callable
+from typing import Any
 
 __all__ = ["StageOutput", "RunOptions", "STAGES", "resolve_stage"]
 

@@ -22,10 +22,11 @@ import re
 import sys
 import tempfile
 import time
+from collections.abc import Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -68,16 +69,16 @@ def plan_cases(scenario: str, spans: Sequence[float] | None, vary: dict[str, lis
     cases = []
     for span in span_list:
         for values in itertools.product(*(vary[k] for k in keys)) if keys else [()]:
-            cases.append(Case(scenario, span, tuple(zip(keys, values))))
+            cases.append(Case(scenario, span, tuple(zip(keys, values, strict=True))))
     return cases
 
 
 def run_case(case: Case, out_dir: str, stages: list[str] | None, quick: bool) -> tuple[str, str]:
     """Run one case (in a worker process) and return (case name, "done" | "skipped" | error line)."""
+    from dataclasses import replace
+
     from .pipeline import run_scenario
     from .stages import RunOptions
-
-    from dataclasses import replace
 
     folder = Path(out_dir) / case.name
     if (folder / "summary.json").is_file():
@@ -192,7 +193,8 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("scenario", help="scenario name or path (the base of every case)")
     p.add_argument("--main-span", default=None, help="comma-separated main spans in metres")
     p.add_argument("--vary", action="append", default=[], metavar="KEY=V1,V2",
-                   help="a dotted scenario key and its values (repeatable), e.g. girder.mass_per_length_kg_m=14000,16000")
+                   help="a dotted scenario key and its values (repeatable), "
+                        "e.g. girder.mass_per_length_kg_m=14000,16000")
     p.add_argument("--stages", default=None, help="comma-separated stages (default: all for the kind)")
     p.add_argument("--out", default="out", type=Path, help="output folder (default out/)")
     p.add_argument("--name", default=None, help="sweep name (default: derived from the scenario)")

@@ -12,7 +12,8 @@ import pytest
 from scipy.optimize import brentq
 
 from bridge.cable import integrate_rk4, solve_cables, solve_main_span, solve_side_span
-from bridge.config import GRAVITY_M_S2 as G, load_scenario
+from bridge.config import GRAVITY_M_S2 as G
+from bridge.config import load_scenario
 from bridge.errors import ConvergenceError
 
 L, SAG = 1624.0, 180.5

@@ -2,7 +2,6 @@
 
 import h5py
 import numpy as np
-import pytest
 
 from bridge.sweep import main, plan_cases
 

@@ -9,8 +9,8 @@ import math
 import pytest
 
 from bridge.config import load_scenario
-from bridge.upscaling import cable_area_for_span, extra_cross_beams, pylon_inertia_ratio, span_limit_m
 from bridge.errors import InputError
+from bridge.upscaling import cable_area_for_span, extra_cross_beams, pylon_inertia_ratio, span_limit_m
 
 TABLE_1_1 = {"great_belt": 0.410, "model_a": 0.566, "model_b": 1.237, "model_c": 3.037}
 TABLE_1_2 = {"great_belt": (180.50, 535), "model_a": (222.22, 659), "model_b": (333.33, 988),
