@@ -50,7 +50,8 @@ class MultimodeResult:
     reduced_frequency: float
     unstable_mode: str
     max_speed_searched_m_s: float
-    divergence_speed_m_s: float = np.nan   # lowest V where a mode's frequency went to zero (static), or NaN
+    divergence_speed_m_s: float = np.nan   # lowest V (up to the flutter speed's interval) where a mode's
+                                           # frequency went to zero (static divergence), or NaN
 
 
 def _state_matrix(model: ModalModel, aero: AerodynamicModel, rho: float, w: float, V: float) -> np.ndarray:
@@ -122,9 +123,13 @@ def pk_sweep(model: ModalModel, aero: AerodynamicModel, air_density: float, max_
                   max_speed_searched_m_s=float(v_hi))
     crossing = np.flatnonzero((zeta[:-1] > 0.0) & (zeta[1:] <= 0.0))  # flat index over (n_V-1, N)
     w_floor = 1e-3 * model.angular_frequencies.min()   # below this an unstable root is static: divergence
-    divergence = np.nan
+    divergence, flutter_at = np.nan, None
     for c in np.sort(crossing):                          # ascending V, then mode
         n0, r = np.unravel_index(c, (speeds.size - 1, model.n_modes))
+        if flutter_at is not None and not np.isnan(divergence):
+            break
+        if flutter_at is not None and speeds[n0] > flutter_at[0]:
+            break                                        # any later divergence is beyond flutter anyway
 
         def zeta_r(V: float, n0=n0, r=r) -> float:
             return float(_damping(aeroelastic_eigenvalues(model, aero, air_density, V, eig[n0], tolerance))[r])
@@ -132,10 +137,12 @@ def pk_sweep(model: ModalModel, aero: AerodynamicModel, air_density: float, max_
         V_c = brentq(zeta_r, speeds[n0], speeds[n0 + 1], xtol=1e-12 * speeds[n0 + 1], rtol=1e-12)
         s_c = aeroelastic_eigenvalues(model, aero, air_density, V_c, eig[n0], tolerance)[r]
         if s_c.imag < w_floor:                             # zero frequency: static divergence, not flutter
-            if np.isnan(divergence):
-                divergence = float(V_c)
-            continue
-        return MultimodeResult(flutter=True, critical_speed_m_s=float(V_c),
+            divergence = float(V_c) if np.isnan(divergence) else divergence
+        elif flutter_at is None:
+            flutter_at = (float(V_c), s_c, r)
+    if flutter_at is not None:
+        V_c, s_c, r = flutter_at
+        return MultimodeResult(flutter=True, critical_speed_m_s=V_c,
                                frequency_hz_at_flutter=float(s_c.imag / (2 * np.pi)),
                                reduced_frequency=float(s_c.imag * model.deck_width_m / V_c),
                                unstable_mode=model.labels[r], divergence_speed_m_s=divergence, **result)
