@@ -206,7 +206,9 @@ class FRFTable:
         _check_within("flutter.reduced_frequency", omega, *self.omega_range, f"the table {self.source}")
         _check_within("flutter.speed_m_s", speed, *self.speed_range, f"the table {self.source}")
         pts = np.stack([np.clip(omega, *self.omega_range), np.clip(speed, *self.speed_range)], axis=-1)
-        return FRF(*(re(pts) + 1j * im(pts) for re, im in (self._interp[n] for n in FRF_NAMES)))
+        pts = pts.reshape(-1, 2)
+        return FRF(*((re(pts) + 1j * im(pts)).reshape(omega.shape)
+                     for re, im in (self._interp[n] for n in FRF_NAMES)))
 
 
 class DerivativeTable:
