@@ -1,0 +1,64 @@
+"""Multimode p-k flutter: agreement with the determinant method, decoupled modes, static divergence.
+
+Sources: the thesis Eq 4.9, 4.23-4.29; Theodorsen (1935), NACA Report 496; the divergence speed of a plate
+with the moment about mid-chord follows from the static moment slope pi/2 (potential flow).
+"""
+
+import numpy as np
+import pytest
+
+from bridge.flutter.aerodynamics import Theodorsen
+from bridge.flutter.determinant import solve_pair
+from bridge.flutter.modal import ModalModel
+from bridge.flutter.multimode import pk_sweep
+
+from conftest import RHO, plate_section, selberg_speed
+
+
+@pytest.mark.parametrize("frequency_ratio, mass_ratio, radius_ratio, damping", [
+    (0.3, 20.0, 0.6, 0.0), (0.4, 50.0, 0.7, 0.005), (0.5, 100.0, 0.8, 0.01), (0.45, 30.0, 0.75, 0.02)])
+def test_two_mode_pk_agrees_with_determinant(frequency_ratio, mass_ratio, radius_ratio, damping):
+    section = plate_section(frequency_ratio, mass_ratio, radius_ratio, damping=damping)
+    vmax = 2 * selberg_speed(section)
+    det = solve_pair(section, Theodorsen(), RHO, vmax, n_speed=60)
+    pk = pk_sweep(section, Theodorsen(), RHO, vmax, n_speed=40)
+    assert det.flutter and pk.flutter
+    assert abs(pk.critical_speed_m_s / det.critical_speed_m_s - 1) < 0.005
+    assert abs(pk.frequency_hz_at_flutter / det.frequency_hz - 1) < 0.005
+    # below V_c every mode is damped; the sweep starts from the structural frequencies
+    below = pk.speed_m_s < pk.critical_speed_m_s
+    assert np.all(pk.damping_ratio[below] > 0)
+    np.testing.assert_allclose(pk.frequency_hz[0], section.frequencies_hz, rtol=0.05)
+
+
+def test_an_uncoupled_extra_mode_does_not_change_the_critical_speed():
+    # S-V2 has no aerodynamic coupling to S-V1 or S-T1 (uu[0,1] = ut[1,2] = 0): the 3-mode p-k result
+    # must be the two-mode determinant result of (S-V1, S-T1).
+    uu = np.diag([0.345, 0.3, 0.0])
+    tt = np.diag([0.0, 0.0, 0.161])
+    ut = np.zeros((3, 3))
+    ut[0, 2] = 0.2
+    model = ModalModel(labels=("S-V1", "S-V2", "S-T1"), kinds=("vertical", "vertical", "torsional"),
+                       symmetries=("S",) * 3, frequencies_hz=np.array([0.12, 0.2, 0.3]),
+                       damping_ratios=np.array([0.005, 0.005, 0.005]), uu=uu, ut=ut, tt=tt,
+                       mass_per_length_kg_m=23_000.0, inertia_per_length_kg_m2_m=2.5e6, deck_width_m=31.0,
+                       deck_length_m=2694.0)
+    det = solve_pair(model.subset([0, 2]), Theodorsen(), RHO, 200.0)
+    pk = pk_sweep(model, Theodorsen(), RHO, 200.0, n_speed=50)
+    assert det.flutter and pk.flutter and pk.unstable_mode in ("S-V1", "S-T1")
+    assert abs(pk.critical_speed_m_s / det.critical_speed_m_s - 1) < 0.005
+    # the extra heave mode is only damped by the air (Theodorsen's H1* < 0): above its structural value
+    assert np.all(pk.damping_ratio[:, 1] > 0.005)
+
+
+def test_torsional_divergence_is_reported_apart_from_flutter():
+    # Weak coupling: no flutter, but static divergence where (1/2) rho V^2 B^2 (pi/2) a_kk L = J a_kk L w_T^2
+    model = ModalModel.from_two_modes(bending_frequency_hz=0.1, torsion_frequency_hz=0.28, a_jj=0.308,
+                                      a_kk=0.239, a_jk=0.038, mass_per_length_kg_m=23_000.0,
+                                      inertia_per_length_kg_m2_m=2.5e6, deck_width_m=31.0, deck_length_m=2694.0)
+    pk = pk_sweep(model, Theodorsen(), RHO, 150.0, n_speed=60)
+    w_t = 2 * np.pi * 0.28
+    V_d = np.sqrt(2 * 2.5e6 * w_t**2 / (RHO * 31.0**2 * np.pi / 2))
+    assert not pk.flutter and np.isnan(pk.critical_speed_m_s)
+    assert abs(pk.divergence_speed_m_s / V_d - 1) < 1e-3
+    assert not solve_pair(model, Theodorsen(), RHO, 150.0).flutter
