@@ -176,7 +176,7 @@ class FRFTable:
                 RegularGridInterpolator((omega, speed), v.imag, bounds_error=True))
 
     @classmethod
-    def from_hdf5(cls, path: str | Path, group: str = "/") -> "FRFTable":
+    def from_hdf5(cls, path: str | Path, group: str = "/") -> FRFTable:
         import h5py
 
         path = Path(path)
@@ -211,6 +211,13 @@ class FRFTable:
                      for re, im in (self._interp[n] for n in FRF_NAMES)))
 
 
+def _linear(x_table: np.ndarray, y_table: np.ndarray):
+    """Linear interpolation of complex values (used when a table has fewer than 4 rows)."""
+    def f(x):
+        return np.interp(x, x_table, y_table.real) + 1j * np.interp(x, x_table, y_table.imag)
+    return f
+
+
 class DerivativeTable:
     """Scanlan's flutter derivatives against K (or reduced velocity U/(fB) = 2 pi / K) from a CSV file.
 
@@ -235,11 +242,10 @@ class DerivativeTable:
         if K.size >= 4:
             self._spline = {n: CubicSpline(K, getattr(h, n)) for n in FRF_NAMES}
         else:
-            self._spline = {n: (lambda x, y=getattr(h, n): np.interp(x, K, y.real) + 1j * np.interp(x, K, y.imag))
-                            for n in FRF_NAMES}
+            self._spline = {n: _linear(K, getattr(h, n)) for n in FRF_NAMES}
 
     @classmethod
-    def from_csv(cls, path: str | Path) -> "DerivativeTable":
+    def from_csv(cls, path: str | Path) -> DerivativeTable:
         path = Path(path)
         if not path.is_file():
             raise InputError("flutter.derivatives_path", str(path), "an existing CSV file")

@@ -36,7 +36,10 @@ STRUCTURAL_FORMS = ("derived", "thesis_eq_4_43")
 def _aero_bracket(model: ModalModel, frf) -> np.ndarray:
     """[h_pu uu_ij + B h_ptheta ut_ij + B h_mu ut_ji + B^2 h_mtheta tt_ij] with shape (..., N, N)."""
     B = model.deck_width_m
-    e = (lambda h: np.asarray(h)[..., None, None])
+
+    def e(h):
+        return np.asarray(h)[..., None, None]
+
     return (e(frf.h_pu) * model.uu + B * e(frf.h_ptheta) * model.ut + B * e(frf.h_mu) * model.ut.T
             + B**2 * e(frf.h_mtheta) * model.tt)
 

@@ -156,11 +156,11 @@ class ModalModel:
             if torsion:
                 out += [(j, torsion[0]) for j in self.modes_of("vertical", s)[:n_vertical]]
         if not out:
-            raise InputError("flutter.modes", list(zip(self.labels, self.kinds, self.symmetries)),
+            raise InputError("flutter.modes", list(zip(self.labels, self.kinds, self.symmetries, strict=True)),
                              "needs at least one symmetric vertical and one symmetric torsional mode")
         return out
 
-    def subset(self, indices: list[int] | tuple[int, ...]) -> "ModalModel":
+    def subset(self, indices: list[int] | tuple[int, ...]) -> ModalModel:
         """The model restricted to the given modes (in that order)."""
         ix = np.asarray(indices, dtype=int)
         return ModalModel(
@@ -177,7 +177,7 @@ class ModalModel:
                        a_jj: float, a_kk: float, a_jk: float, mass_per_length_kg_m: float,
                        inertia_per_length_kg_m2_m: float, deck_width_m: float, deck_length_m: float,
                        bending_damping_ratio: float = 0.0, torsion_damping_ratio: float = 0.0,
-                       labels: tuple[str, str] = ("S-V1", "S-T1")) -> "ModalModel":
+                       labels: tuple[str, str] = ("S-V1", "S-T1")) -> ModalModel:
         """A bending mode j (Theta_j = 0) and a torsional mode k (U_k = 0), Eq 4.30, given a_jj, a_kk,
         a_jk of Eq 4.34 directly (e.g. the thesis's Table 3.6)."""
         for key, v in (("a_jj", a_jj), ("a_kk", a_kk)):
@@ -196,7 +196,7 @@ class ModalModel:
     @classmethod
     def section(cls, *, mass_per_length_kg_m: float, inertia_per_length_kg_m2_m: float,
                 heave_frequency_hz: float, pitch_frequency_hz: float, deck_width_m: float,
-                heave_damping_ratio: float = 0.0, pitch_damping_ratio: float = 0.0) -> "ModalModel":
+                heave_damping_ratio: float = 0.0, pitch_damping_ratio: float = 0.0) -> ModalModel:
         """A 2-DOF sectional model (rigid section on springs, elastic axis at mid-chord) of unit length.
 
         Heave mode: U = 1, Theta = 0; pitch mode: U = 0, Theta = 1.  Hence uu = diag(1, 0),
@@ -213,15 +213,15 @@ class ModalModel:
 
     # ---------------------------------------------------------------- scenario input
     @classmethod
-    def from_mapping(cls, mapping, where: str = "modal") -> "ModalModel":
+    def from_mapping(cls, mapping, where: str = "modal") -> ModalModel:
         """A ``[modal]`` table of a scenario file.  Either the full form (keys = the field names;
         uu, ut, tt as lists of rows) or the two-mode form of :meth:`from_two_modes` (keys
         bending_frequency_hz, torsion_frequency_hz, a_jj, a_kk, a_jk, mass_per_length_kg_m,
         inertia_per_length_kg_m2_m, deck_width_m, deck_length_m, optional bending_damping_ratio,
         torsion_damping_ratio, labels).  Unknown or missing keys raise InputError naming ``where.key``."""
+        import inspect
         from collections.abc import Mapping
         from dataclasses import fields
-        import inspect
 
         if not isinstance(mapping, Mapping):
             raise InputError(where, mapping, "must be a table")

@@ -9,7 +9,8 @@ A_a = A_R + i A_I ~ A_R + (A_I / w) s, which is exact on the imaginary axis (s =
 is a real quadratic eigenvalue problem (state-space form, 2N eigenvalues); for each mode the trial w is
 replaced by Im(s) of the tracked eigenvalue until it no longer changes.  Damping ratio
 zeta = -Re(s) / |s|, frequency Im(s) / 2 pi.  Flutter: the first V where a damping ratio crosses zero
-(refined by Brent's method on zeta(V)); a crossing at zero frequency is static divergence, reported apart.  At that point s = i w exactly, so with two modes the p-k
+(refined by Brent's method on zeta(V)); a crossing at zero frequency is static divergence, reported
+apart.  At a flutter point s = i w exactly, so with two modes the p-k
 critical speed is the determinant method's (Eq 4.29) to the iteration tolerance.
 Lateral modes carry no aerodynamic FRF in the thesis's model and are left out.
 """
@@ -76,7 +77,7 @@ def aeroelastic_eigenvalues(model: ModalModel, aero: AerodynamicModel, air_densi
     for r, s_prev in enumerate(np.asarray(guesses, dtype=np.complex128)):
         s = s_prev
         w = max(abs(s.imag), 1e-6 * model.angular_frequencies.min())
-        for it in range(max_iterations):
+        for _ in range(max_iterations):
             lam = np.linalg.eigvals(_state_matrix(model, aero, air_density, w, speed))
             lam = lam[lam.imag >= 0.0]
             s = lam[np.argmin(np.abs(lam - s))]

@@ -18,9 +18,10 @@ Keys (all optional; defaults give a Theodorsen thin-plate analysis up to 150 m/s
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, fields
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any
 
 from bridge.errors import InputError, check_range
 from bridge.flutter.aerodynamics import AerodynamicModel, DerivativeTable, FRFTable, QuasiSteady, Theodorsen
@@ -87,7 +88,7 @@ class FlutterOptions:
                 _string(where, key, getattr(self, key))
 
     @classmethod
-    def from_mapping(cls, mapping: Mapping[str, Any], where: str = "flutter") -> "FlutterOptions":
+    def from_mapping(cls, mapping: Mapping[str, Any], where: str = "flutter") -> FlutterOptions:
         """Validate a ``[flutter]`` table; unknown keys and bad values raise InputError naming ``where.key``."""
         if not isinstance(mapping, Mapping):
             raise InputError(where, mapping, "must be a table")

@@ -12,8 +12,9 @@ ut[heave, pitch] = 1, L = 1 m.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, fields
-from typing import Any, Mapping
+from typing import Any
 
 from bridge.errors import InputError, check_range
 from bridge.flutter.modal import ModalModel
@@ -56,7 +57,7 @@ class SectionModel:
             raise InputError(f"{where}.aerodynamics", self.aerodynamics, f"one of {', '.join(AERODYNAMIC_MODELS)}")
 
     @classmethod
-    def from_mapping(cls, mapping: Mapping[str, Any], where: str = "section") -> "SectionModel":
+    def from_mapping(cls, mapping: Mapping[str, Any], where: str = "section") -> SectionModel:
         """Validate a ``[section]`` table; unknown/missing keys and bad values raise InputError naming
         ``where.key``, the value and the allowed range."""
         if not isinstance(mapping, Mapping):

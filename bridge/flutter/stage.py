@@ -195,7 +195,7 @@ def _report(d: FlutterStageResult, source: str, fopts: FlutterOptions) -> str:
 
 
 def _figures(d: FlutterStageResult) -> dict[str, Any]:
-    from matplotlib.figure import Figure   # Agg canvas, no pyplot state
+    from matplotlib.figure import Figure  # Agg canvas, no pyplot state
 
     figs: dict[str, Any] = {}
     shown = d.governing or d.pairs[0]

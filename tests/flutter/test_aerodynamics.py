@@ -53,7 +53,7 @@ def test_theodorsen_derivatives_reproduce_check_table(reduced_velocity):
     # H1* = -8.226 and A3* = 4.115 where the closed forms give -8.2255 and 4.1145 (rounding of the source).
     K = 2 * np.pi / reduced_velocity
     d = derivatives_from_frf(np.array([K]), Theodorsen().frf(K, 1.0))
-    for name, printed in zip(FlutterDerivatives._fields, CHECK_TABLE[reduced_velocity]):
+    for name, printed in zip(FlutterDerivatives._fields, CHECK_TABLE[reduced_velocity], strict=True):
         decimals = len(f"{printed}".split(".")[1])
         assert abs(getattr(d, name)[0] - printed) <= 1.0 * 10.0**-decimals, (name, getattr(d, name)[0], printed)
 

@@ -9,15 +9,20 @@ import csv
 
 import numpy as np
 import pytest
+from conftest import RHO, plate_section, selberg_speed
 
 from bridge.errors import InputError
 from bridge.flutter.aerodynamics import DerivativeTable, FRFTable, Theodorsen
 from bridge.flutter.derivatives import derivatives_from_frf
-from bridge.flutter.determinant import (determinant, dimensional_matrix, governing, reduced_matrix, solve_pair,
-                                        solve_pairs)
+from bridge.flutter.determinant import (
+    determinant,
+    dimensional_matrix,
+    governing,
+    reduced_matrix,
+    solve_pair,
+    solve_pairs,
+)
 from bridge.flutter.modal import ModalModel
-
-from conftest import RHO, plate_section, selberg_speed
 
 
 def bridge_pair(**kw) -> ModalModel:
@@ -34,7 +39,9 @@ def test_structural_term_follows_from_the_modal_equation():
     model = bridge_pair()
     t, dt = 0.37, 1e-4
     for w in (0.3, 0.9, 2.5):
-        q = lambda s: np.exp(1j * w * s)
+        def q(s, w=w):
+            return np.exp(1j * w * s)
+
         qd = (q(t + dt) - q(t - dt)) / (2 * dt)
         qdd = (q(t + dt) - 2 * q(t) + q(t - dt)) / dt**2
         m, wj, z = model.modal_masses, model.angular_frequencies, model.damping_ratios

@@ -6,13 +6,12 @@ with the moment about mid-chord follows from the static moment slope pi/2 (poten
 
 import numpy as np
 import pytest
+from conftest import RHO, plate_section, selberg_speed
 
 from bridge.flutter.aerodynamics import Theodorsen
 from bridge.flutter.determinant import solve_pair
 from bridge.flutter.modal import ModalModel
 from bridge.flutter.multimode import pk_sweep
-
-from conftest import RHO, plate_section, selberg_speed
 
 
 @pytest.mark.parametrize("frequency_ratio, mass_ratio, radius_ratio, damping", [
