@@ -19,10 +19,10 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from .elements import element_matrices
+from .elements import ElementSet, element_matrices
 from .model import FrameModel
 
-__all__ = ["AssembledModel", "assemble", "coo_triplets", "constraint_transform"]
+__all__ = ["AssembledModel", "assemble", "global_matrices", "coo_triplets", "constraint_transform"]
 
 
 @dataclass(frozen=True)
@@ -82,11 +82,17 @@ def constraint_transform(model: FrameModel) -> sp.csr_matrix:
                          shape=(6 * n, int(free.sum()))).tocsr()
 
 
+def global_matrices(conn: np.ndarray, elements: ElementSet, n_nodes: int,
+                    device: str = "cpu") -> tuple[sp.csr_matrix, sp.csr_matrix, sp.csr_matrix]:
+    """Unconstrained global (K_elastic, M, K_geometric), 6 DOFs per node, from the Warp kernel."""
+    k_e, m_e, g_e = element_matrices(elements, device=device)
+    n = 6 * n_nodes
+    return tuple(_to_csr(conn, blk, n) for blk in (k_e, m_e, g_e))
+
+
 def assemble(model: FrameModel, device: str = "cpu") -> AssembledModel:
     """Element matrices (Warp) -> global CSR -> constraint reduction; K = K_elastic + K_geometric."""
-    k_e, m_e, g_e = element_matrices(model.elements, device=device)
-    n = 6 * model.n_nodes
-    K, M, G = (_to_csr(model.conn, blk, n) for blk in (k_e, m_e, g_e))
+    K, M, G = global_matrices(model.conn, model.elements, model.n_nodes, device)
     T = constraint_transform(model)
     Kr = (T.T @ (K + G) @ T).tocsr()
     Mr = (T.T @ M @ T).tocsr()

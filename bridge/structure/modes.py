@@ -6,9 +6,10 @@ about the bridge axis), V = u_x (lateral), W = u_z (longitudinal).
 Kind (thesis 4.4 uses "bending" and "torsional"): from the girder's modal kinetic energy shares,
 with the deck's mu and J of Eq 4.7 as weights (trapezoidal integration along z):
     E_vertical = mu int U^2, E_torsional = J int Theta^2, E_lateral = mu int V^2, E_longitudinal = mu int W^2
-the largest share names the mode; if the girder's own kinetic energy (the same four terms with the
-girder's mu_b and J_b of Table 3.3) is below ``CABLE_SHARE`` of the mode's total kinetic energy
-phi^T M phi, the mode is a "cable" mode (cables, hangers or pylons move, the deck barely does).  Symmetry about mid-span: the dominant field f(z) is compared with its mirror
+the largest share names the mode; if the deck energy (the sum of the four terms, i.e. the girder with
+the cable mass moving with it as Eq 4.7 assumes) is below ``CABLE_SHARE`` of the mode's total kinetic
+energy phi^T M phi, the mode is a "cable" mode (cables, hangers or pylons move, the deck barely does).
+The ratio can exceed 1 slightly where the cables swing less than the deck (lateral modes).  Symmetry about mid-span: the dominant field f(z) is compared with its mirror
 f(2 z_mid - z); correlation > 0 is "S", < 0 "SS".
 
 Normalisation (Eq 4.31-4.32): vertical modes max|U| = 1, torsional max|Theta| = 1, lateral max|V| = 1,
@@ -38,7 +39,7 @@ from ..config import Scenario
 __all__ = ["ModeSet", "classify_modes", "KINDS_ALL", "CABLE_SHARE", "trapezoid_weights"]
 
 KINDS_ALL = ("vertical", "torsional", "lateral", "longitudinal", "cable")
-CABLE_SHARE = 0.2
+CABLE_SHARE = 0.25
 _KIND_LETTER = {"vertical": "V", "torsional": "T", "lateral": "L", "longitudinal": "Z", "cable": "C"}
 
 
@@ -60,7 +61,7 @@ class ModeSet:
     symmetries: tuple[str, ...]
     labels: tuple[str, ...]
     energy_shares: np.ndarray      # (n, 4): vertical, torsional, lateral, longitudinal of the deck energy
-    deck_share: np.ndarray         # girder kinetic energy / total modal kinetic energy
+    deck_share: np.ndarray         # deck kinetic energy (Eq 4.7 mu, J) / total modal kinetic energy
     modal_masses: np.ndarray
     damping_ratios: np.ndarray
     z_m: np.ndarray
@@ -115,7 +116,6 @@ def classify_modes(scenario: Scenario, frequencies_hz: np.ndarray, shapes_full: 
     """Classify, normalise and damp the modes (module docstring).  ``shapes_full`` (6 n_nodes, n) are the
     eigenvectors expanded to all DOFs, ``mass_full`` the full consistent mass matrix."""
     mu, J = scenario.deck_mass_per_length_kg_m, scenario.deck_inertia_per_length_kg_m2_m
-    mu_b, J_b = scenario.girder.mass_per_length_kg_m, scenario.girder.mass_moment_of_inertia_kg_m2_m
     w = trapezoid_weights(z)
     n = shapes_full.shape[1]
     dof = 6 * girder_nodes
@@ -129,8 +129,7 @@ def classify_modes(scenario: Scenario, frequencies_hz: np.ndarray, shapes_full: 
         fields = [ph[dof + 1], ph[dof + 5], ph[dof + 0], ph[dof + 2]]
         e = np.array([mu, J, mu, mu]) * np.array([w @ f**2 for f in fields])
         total = float(ph @ (mass_full @ ph))
-        e_girder = np.array([mu_b, J_b, mu_b, mu_b]) * e / np.array([mu, J, mu, mu])
-        deck_share[i] = e_girder.sum() / total if total > 0 else 0.0
+        deck_share[i] = e.sum() / total if total > 0 else 0.0
         shares[i] = e / e.sum() if e.sum() > 0 else 0.0
         dominant = int(np.argmax(e))
         kind = ("vertical", "torsional", "lateral", "longitudinal")[dominant]

@@ -53,9 +53,9 @@ def model_figure(result: FemResult, label: str, scale_m: float | None = None):
     ax = fig.add_subplot(projection="3d")
     # plot (z, x, y): along, across, up
     for pts, kw in ((mod.nodes, dict(color="0.7", lw=0.5)), (mod.nodes + scale * shape, dict(color="C3", lw=0.8))):
-        seg = pts[mod.conn]
-        for a, b in seg:
-            ax.plot([a[2], b[2]], [a[0], b[0]], [a[1], b[1]], **kw)
+        seg = pts[mod.conn]                                   # (e, 2, 3); one polyline with NaN breaks
+        line = np.concatenate([seg, np.full((len(seg), 1, 3), np.nan)], axis=1).reshape(-1, 3)
+        ax.plot(line[:, 2], line[:, 0], line[:, 1], **kw)
     ax.set_xlabel("z [m]")
     ax.set_ylabel("x [m]")
     ax.set_zlabel("y [m]")
