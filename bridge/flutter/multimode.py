@@ -70,26 +70,47 @@ def _state_matrix(model: ModalModel, aero: AerodynamicModel, rho: float, w: floa
 
 
 def aeroelastic_eigenvalues(model: ModalModel, aero: AerodynamicModel, air_density: float, speed: float,
-                            guesses: np.ndarray, tolerance: float = 1e-10, max_iterations: int = 200) -> np.ndarray:
-    """p-k eigenvalue s_r of each mode at wind speed V, iterating on frequency from ``guesses``
-    (complex, one per mode: the previous speed's eigenvalues, or i w_r at the first speed)."""
-    out = np.empty(model.n_modes, dtype=np.complex128)
+                            guesses: np.ndarray, shapes: np.ndarray | None = None, tolerance: float = 1e-10,
+                            max_iterations: int = 200) -> tuple[np.ndarray, np.ndarray]:
+    """p-k eigenvalue s_r and modal shape (complex N-vector of modal amplitudes) of each mode at wind
+    speed V, iterating on frequency from ``guesses`` (one per mode: the previous speed's eigenvalues, or
+    i w_r at the first speed).
+
+    Mode tracking: at each trial frequency the eigenvalue whose shape correlates best with the previous
+    speed's shape of the same mode (modal assurance criterion in mass-normalised coordinates
+    sqrt(m_i) q_i, columns of ``shapes``; identity at the start) is taken; nearest eigenvalue breaks
+    ties.  Tracking by eigenvalue distance alone lets modes with close frequencies (S-V5, S-T1, SS-V5
+    of the Great Belt) collapse onto one branch and miss the flutter branch.
+    """
+    n = model.n_modes
+    shapes = np.eye(n, dtype=np.complex128) if shapes is None else np.asarray(shapes, dtype=np.complex128)
+    out, out_shapes = np.empty(n, dtype=np.complex128), np.empty((n, n), dtype=np.complex128)
+    w_floor = 1e-6 * model.angular_frequencies.min()
+    scale = np.sqrt(model.modal_masses)[:, None]   # shapes compared in mass-normalised coordinates
     for r, s_prev in enumerate(np.asarray(guesses, dtype=np.complex128)):
+        ref = shapes[:, r] / np.linalg.norm(shapes[:, r])
         s = s_prev
-        w = max(abs(s.imag), 1e-6 * model.angular_frequencies.min())
+        w = max(abs(s.imag), w_floor)
         for _ in range(max_iterations):
-            lam = np.linalg.eigvals(_state_matrix(model, aero, air_density, w, speed))
-            lam = lam[lam.imag >= 0.0]
-            s = lam[np.argmin(np.abs(lam - s))]
-            w_new = max(s.imag, 1e-6 * model.angular_frequencies.min())
-            if abs(w_new - w) <= tolerance * w:
+            lam, vec = np.linalg.eig(_state_matrix(model, aero, air_density, w, speed))
+            keep = lam.imag >= 0.0
+            lam, X = lam[keep], vec[:n, keep]
+            X = scale * X
+            X = X / np.linalg.norm(X, axis=0)
+            mac = np.abs(ref.conj() @ X) ** 2
+            score = mac - 1e-6 * np.abs(lam - s_prev) / max(abs(s_prev), w_floor)
+            i = int(np.argmax(score))
+            s, phi = lam[i], X[:, i]
+            w_new = max(s.imag, w_floor)
+            change = abs(w_new - w) / w
+            if change <= tolerance:
                 break
             w = w_new
         else:
             raise ConvergenceError(f"p-k frequency iteration, mode {model.labels[r]} at V = {speed:g} m/s",
-                                   max_iterations, abs(w_new - w) / w, tolerance)
-        out[r] = s
-    return out
+                                   max_iterations, change, tolerance)
+        out[r], out_shapes[:, r] = s, phi
+    return out, out_shapes
 
 
 def _damping(s: np.ndarray) -> np.ndarray:
@@ -113,11 +134,12 @@ def pk_sweep(model: ModalModel, aero: AerodynamicModel, air_density: float, max_
     v_lo = max(s_lo, 0.01 * v_hi) if min_speed_m_s is None else check_range(
         "flutter.min_speed_m_s", min_speed_m_s, low=s_lo, high=v_hi, high_open=True)
     speeds = np.linspace(v_lo, v_hi, int(n_speed))
-    s = 1j * model.angular_frequencies
+    s, phi = 1j * model.angular_frequencies, np.eye(model.n_modes, dtype=np.complex128)
     eig = np.empty((speeds.size, model.n_modes), dtype=np.complex128)
+    shapes = np.empty((speeds.size, model.n_modes, model.n_modes), dtype=np.complex128)
     for n, V in enumerate(speeds):
-        s = aeroelastic_eigenvalues(model, aero, air_density, V, s, tolerance)
-        eig[n] = s
+        s, phi = aeroelastic_eigenvalues(model, aero, air_density, V, s, phi, tolerance)
+        eig[n], shapes[n] = s, phi
     zeta = _damping(eig)
     freq = eig.imag / (2 * np.pi)
     result = dict(labels=model.labels, speed_m_s=speeds, frequency_hz=freq, damping_ratio=zeta,
@@ -133,10 +155,11 @@ def pk_sweep(model: ModalModel, aero: AerodynamicModel, air_density: float, max_
             break                                        # any later divergence is beyond flutter anyway
 
         def zeta_r(V: float, n0=n0, r=r) -> float:
-            return float(_damping(aeroelastic_eigenvalues(model, aero, air_density, V, eig[n0], tolerance))[r])
+            s_r = aeroelastic_eigenvalues(model, aero, air_density, V, eig[n0], shapes[n0], tolerance)[0][r]
+            return float(_damping(np.array([s_r]))[0])
 
         V_c = brentq(zeta_r, speeds[n0], speeds[n0 + 1], xtol=1e-12 * speeds[n0 + 1], rtol=1e-12)
-        s_c = aeroelastic_eigenvalues(model, aero, air_density, V_c, eig[n0], tolerance)[r]
+        s_c = aeroelastic_eigenvalues(model, aero, air_density, V_c, eig[n0], shapes[n0], tolerance)[0][r]
         if s_c.imag < w_floor:                             # zero frequency: static divergence, not flutter
             divergence = float(V_c) if np.isnan(divergence) else divergence
         elif flutter_at is None:

@@ -61,3 +61,23 @@ def test_torsional_divergence_is_reported_apart_from_flutter():
     assert not pk.flutter and np.isnan(pk.critical_speed_m_s)
     assert abs(pk.divergence_speed_m_s / V_d - 1) < 1e-3
     assert not solve_pair(model, Theodorsen(), RHO, 150.0).flutter
+
+
+@pytest.mark.parametrize("frequencies_hz", [(0.12, 0.2767, 0.2782, 0.2842), (0.09, 0.27, 0.28, 0.285)])
+def test_mode_tracking_through_close_frequencies(frequencies_hz):
+    # Two uncoupled bending modes just below and above the torsional one (as S-V5, S-T1, SS-V5 of the
+    # Great Belt FEM model).  Tracking by nearest eigenvalue follows the wrong branch here (it labelled
+    # the first case's flutter mode "V5" and missed flutter in the second); tracking by the modal
+    # assurance criterion must find the (V1, T1) determinant speed and name T1.
+    uu = np.diag([0.3, 0.3, 0.0, 0.3])
+    tt = np.diag([0.0, 0.0, 0.25, 0.0])
+    ut = np.zeros((4, 4))
+    ut[0, 2] = 0.25
+    model = ModalModel(labels=("V1", "V5", "T1", "W5"), kinds=("vertical", "vertical", "torsional", "vertical"),
+                       symmetries=("S",) * 4, frequencies_hz=np.array(frequencies_hz),
+                       damping_ratios=np.full(4, 0.005), uu=uu, ut=ut, tt=tt, mass_per_length_kg_m=23_000.0,
+                       inertia_per_length_kg_m2_m=2.5e6, deck_width_m=31.0, deck_length_m=2694.0)
+    det = solve_pair(model.subset([0, 2]), Theodorsen(), RHO, 150.0)
+    pk = pk_sweep(model, Theodorsen(), RHO, 150.0, n_speed=60)
+    assert det.flutter and pk.flutter and pk.unstable_mode == "T1"
+    assert abs(pk.critical_speed_m_s / det.critical_speed_m_s - 1) < 0.005
