@@ -95,9 +95,10 @@ class ModalModel:
                 raise InputError(f"modal.{name}", "non-symmetric matrix", "must be symmetric")
             if np.any(np.diag(a) < 0.0):
                 raise InputError(f"modal.{name}", np.diag(a).tolist(), "diagonal must be >= 0")
-        if np.any(np.diag(uu) + np.diag(tt) <= 0.0):
-            bad = [labels[i] for i in np.flatnonzero(np.diag(uu) + np.diag(tt) <= 0.0)]
-            raise InputError("modal.uu/tt", bad, "every mode needs uu[i,i] > 0 or tt[i,i] > 0")
+        # a lateral mode may have no vertical or torsional component; the others need one (a modal mass)
+        bad = [labels[i] for i in range(n) if kinds[i] != "lateral" and uu[i, i] + tt[i, i] <= 0.0]
+        if bad:
+            raise InputError("modal.uu/tt", bad, "every vertical/torsional mode needs uu[i,i] > 0 or tt[i,i] > 0")
         mu = check_range("modal.mass_per_length_kg_m", self.mass_per_length_kg_m, low=0.0, low_open=True)
         J = check_range("modal.inertia_per_length_kg_m2_m", self.inertia_per_length_kg_m2_m,
                         low=0.0, low_open=True)

@@ -180,3 +180,21 @@ def test_theodorsen_through_scanlan_csv_gives_the_same_critical_speed(tmp_path):
     assert abs(via_csv.frequency_hz / direct.frequency_hz - 1) < 1e-3
     with pytest.raises(InputError, match="reduced_frequency"):
         table.frf(20.0, 50.0)
+
+
+def test_lateral_modes_are_accepted_but_left_out_of_pairs():
+    # the FEM may hand over lateral modes with no vertical/torsional component; they form no pair
+    uu = np.diag([0.0, 0.3, 0.0])
+    tt = np.diag([0.0, 0.0, 0.25])
+    ut = np.zeros((3, 3))
+    ut[1, 2] = 0.2
+    model = ModalModel(labels=("S-L1", "S-V1", "S-T1"), kinds=("lateral", "vertical", "torsional"),
+                       symmetries=("S",) * 3, frequencies_hz=np.array([0.05, 0.1, 0.28]),
+                       damping_ratios=np.zeros(3), uu=uu, ut=ut, tt=tt, mass_per_length_kg_m=23_000.0,
+                       inertia_per_length_kg_m2_m=2.5e6, deck_width_m=31.0, deck_length_m=2694.0)
+    assert model.pairs("all") == [(1, 2)]
+    with pytest.raises(InputError, match="uu/tt"):
+        ModalModel(labels=("S-V1", "S-T1"), kinds=("vertical", "torsional"), symmetries=("S", "S"),
+                   frequencies_hz=np.array([0.1, 0.28]), damping_ratios=np.zeros(2), uu=np.zeros((2, 2)),
+                   ut=np.zeros((2, 2)), tt=np.diag([0.0, 0.25]), mass_per_length_kg_m=1.0,
+                   inertia_per_length_kg_m2_m=1.0, deck_width_m=1.0, deck_length_m=1.0)
