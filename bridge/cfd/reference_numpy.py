@@ -74,7 +74,8 @@ class NumpyFlow:
 
     def _predict(self, u, v, u0, v0, us, vs, dt, a, b):
         g, nx, ny = GHOST, self.grid.nx, self.grid.ny
-        dx, s, p, nu, hc, hf = self.grid.dx, self.scheme, self.p, self.nu, self.hc, self.hf
+        dx, s, nu, hc, hf = self.grid.dx, self.scheme, self.nu, self.hc, self.hf
+        p = self.p if self.config.pressure == "incremental" else np.zeros_like(self.p)
         # u-faces: rows g..g+ny-1, columns g+1..g+nx-1
         J0, J1, I0, I1 = g, g + ny, g + 1, g + nx
 
@@ -135,6 +136,8 @@ class NumpyFlow:
         div = ((us[rows, g + 1:g + nx + 1] - us[rows, cols]) / dx
                + (vs[g + 1:g + ny + 1, cols] - vs[rows, cols]) / self.hc[rows, None]) / c
         phi = self.poisson.solve(div)
+        if self.config.pressure == "full":
+            self.p[...] = 0.0
         du[rows, :] = us[rows, :]
         du[rows, g + 1:g + nx] -= c * np.diff(phi, axis=1) / dx
         dv[:, :] = vs

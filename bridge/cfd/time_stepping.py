@@ -57,6 +57,7 @@ class FlowConfig:
     fourier: float = 0.2  # viscous limit dt <= fourier * h_min^2 / nu_max
     dt: float | None = None  # fixed step; None: from cfl and fourier
     dt_max: float = np.inf
+    pressure: str = "full"  # "full": predictor without grad p, p = phi of the last stage; or "incremental"
     bc: BoundaryConditions = field(default_factory=BoundaryConditions)
     threads: int = 2
 
@@ -74,6 +75,8 @@ class FlowConfig:
             raise ValueError(f"fourier: allowed (0, 0.25], got {self.fourier}")
         if self.dt is not None and not self.dt > 0:
             raise ValueError(f"dt: must be > 0 or None, got {self.dt}")
+        if self.pressure not in ("incremental", "full"):
+            raise ValueError(f"pressure: {self.pressure!r} unknown; allowed ('incremental', 'full')")
         if self.threads < 1:
             raise ValueError(f"threads: must be >= 1, got {self.threads}")
 
@@ -104,6 +107,7 @@ class Simulation:
         self.u, self.v, self.p = z(ushape), z(vshape), z(pshape)
         self.u_stage, self.v_stage = z(ushape), z(vshape)
         self.u_star, self.v_star = z(ushape), z(vshape)
+        self._p_zero = z(pshape) if config.pressure == "full" else None
         self.nu = wp.full(pshape, config.nu, dtype=WP_DTYPE, device=dev)
         self.rhs, self.phi = z((ny, nx)), z((ny, nx))
         self.hy_c = wp.array(grid.hy_cells(), dtype=WP_DTYPE, device=dev)
@@ -168,9 +172,10 @@ class Simulation:
     def _predict(self, src_u, src_v, u0, v0, dt, a, b):
         g, nx, ny = GHOST, self.grid.nx, self.grid.ny
         dx, s = self.grid.dx, self.scheme
-        self.L.rows(_k.predict_u, ny, g, [src_u, src_v, self.p, self.nu, u0, self.u_star, self.hy_c,
+        p = self.p if self.config.pressure == "incremental" else self._p_zero
+        self.L.rows(_k.predict_u, ny, g, [src_u, src_v, p, self.nu, u0, self.u_star, self.hy_c,
                                           self.hy_f, dx, dt, a, b, g + 1, g + nx, ROW0, s])
-        self.L.rows(_k.predict_v, ny - 1, g + 1, [src_u, src_v, self.p, self.nu, v0, self.v_star, self.hy_c,
+        self.L.rows(_k.predict_v, ny - 1, g + 1, [src_u, src_v, p, self.nu, v0, self.v_star, self.hy_c,
                                                   self.hy_f, dx, dt, a, b, g, g + nx, ROW0, s])
 
     def _project(self, dst_u, dst_v, c):
@@ -181,6 +186,8 @@ class Simulation:
             self.poisson.solve(self._rhs_np, out=self._phi_np)
         else:
             self.phi.assign(self.poisson.solve(self.rhs.numpy()))
+        if self.config.pressure == "full":
+            self.p.zero_()
         self.L.rows(_k.project, ny, 0, [self.u_star, self.v_star, self.phi, self.hy_f, self.grid.dx, c,
                                         g, nx, ny, ROW0, dst_u, dst_v, self.p])
 
