@@ -195,6 +195,7 @@ def _report(d: FlutterStageResult, source: str, fopts: FlutterOptions) -> str:
 
 
 def _figures(d: FlutterStageResult) -> dict[str, Any]:
+    import matplotlib
     from matplotlib.figure import Figure  # Agg canvas, no pyplot state
 
     figs: dict[str, Any] = {}
@@ -213,6 +214,7 @@ def _figures(d: FlutterStageResult) -> dict[str, Any]:
         ax.plot([], [], "C1--", label="f2 = Im det = 0")
         if shown.flutter:
             ax.plot(shown.critical_speed_m_s, shown.reduced_frequency, "ko", label="(V_c, Omega_c)")
+        ax.set_yscale("log")
         ax.set_xlabel("V [m/s]")
         ax.set_ylabel("Omega = w B / V")
         ax.set_title(f"Determinant components, pair {_pair_name(shown)} (Eq 5.16)")
@@ -220,18 +222,21 @@ def _figures(d: FlutterStageResult) -> dict[str, Any]:
         figs["flutter_determinant.png"] = fig
     if d.multimode is not None:
         m = d.multimode
-        fig = Figure(figsize=(6.4, 6.4))
+        fig = Figure(figsize=(8.0, 6.4), layout="constrained")
         ax1, ax2 = fig.add_subplot(2, 1, 1), fig.add_subplot(2, 1, 2)
+        colours = matplotlib.colormaps["tab20"]
         for i, label in enumerate(m.labels):
-            ax1.plot(m.speed_m_s, m.damping_ratio[:, i], label=label)
-            ax2.plot(m.speed_m_s, m.frequency_hz[:, i], label=label)
+            style = dict(color=colours(i % 20), ls="--" if label.startswith("SS-") else "-", label=label)
+            ax1.plot(m.speed_m_s, m.damping_ratio[:, i], **style)
+            ax2.plot(m.speed_m_s, m.frequency_hz[:, i], **style)
         ax1.axhline(0.0, color="k", lw=0.5)
         if m.flutter:
             ax1.axvline(m.critical_speed_m_s, color="k", ls=":", label=f"V_c = {m.critical_speed_m_s:.1f} m/s")
         ax1.set_ylabel("damping ratio")
         ax2.set_ylabel("frequency [Hz]")
         ax2.set_xlabel("V [m/s]")
-        ax1.legend(fontsize="small")
+        ax1.legend(fontsize="small", loc="center left", bbox_to_anchor=(1.01, 0.0),
+                   ncol=1 + len(m.labels) // 13)
         ax1.set_title("Multimode p-k: damping and frequency against wind speed")
         figs["flutter_damping.png"] = fig
     return figs
