@@ -46,12 +46,7 @@ def test_body_at_rest_in_uniform_flow_symmetric_drag():
     assert 2.0 < cd < 6.0
 
 
-def test_added_mass_of_an_oscillating_cylinder():
-    """Cylinder oscillating in fluid at rest, x = A sin(w t), thin Stokes layer (beta = D^2 f/nu =
-    1000): the force in phase with the acceleration is -C_m rho (pi D^2/4) a with C_m = 1 from
-    potential theory (+ about 7 % Stokes-layer correction 4/sqrt(pi beta) + a few % confinement in
-    an 8D box). Checks the forcing impulse and the internal-fluid correction together."""
-    n = 16
+def _added_mass_coefficient(n):
     grid = CartesianGrid.uniform(8 * n, 8 * n, (-4.0, 4.0), (-4.0, 4.0))
     amp, omega, nu = 0.05, 2 * np.pi, 1e-3
     sim = Simulation(grid, FlowConfig(nu=nu, bc=SLIP_BOX))
@@ -64,12 +59,24 @@ def test_added_mass_of_an_oscillating_cylinder():
         h(sim)
     t, f = h.array()
     sel = t > 1.0  # second period
-    fx = f[sel, 0, 0]
     basis = np.column_stack([np.sin(omega * t[sel]), np.cos(omega * t[sel])])
-    (a_sin, _), *_ = np.linalg.lstsq(basis, fx, rcond=None)
-    # acceleration = -A w^2 sin(w t); F = -C_m m_a a = C_m m_a A w^2 sin(w t)
-    c_m = a_sin / (np.pi / 4 * amp * omega ** 2)
-    assert 0.95 < c_m < 1.3, c_m
+    (a_sin, _), *_ = np.linalg.lstsq(basis, f[sel, 0, 0], rcond=None)
+    # acceleration = -A w^2 sin(w t); F = -C_m m_a a = C_m m_a A w^2 sin(w t), m_a = rho pi D^2/4
+    return a_sin / (np.pi / 4 * amp * omega ** 2)
+
+
+def test_added_mass_of_an_oscillating_cylinder():
+    """Cylinder oscillating in fluid at rest, x = A sin(w t), A = D/20, thin Stokes layer
+    (beta = D^2 f / nu = 1000): the force in phase with the acceleration is -C_m rho (pi D^2/4) a,
+    C_m = 1 from potential theory, about 1.07 with the Stokes-layer correction 4/sqrt(pi beta)
+    (Stokes 1851, Wang 1968) and a few per cent more for the 8D closed box: C_ref ~ 1.1.
+    Checks the forcing impulse and the internal-fluid correction together. Measured: C_m = 1.41 at
+    D/16 and 1.22 at D/32 (the Stokes layer, 0.02 D thick, is not resolved; error ~ first order
+    in h), so the test asserts the approach to C_ref, not a coarse-grid match."""
+    c_ref = 1.1
+    c16, c32 = _added_mass_coefficient(16), _added_mass_coefficient(32)
+    assert 1.0 < c32 < 1.3, c32
+    assert abs(c32 - c_ref) < 0.6 * abs(c16 - c_ref), (c16, c32)
 
 
 def test_nan_monitor_restores_last_good_state_and_stops():
