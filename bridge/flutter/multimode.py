@@ -71,7 +71,7 @@ def _state_matrix(model: ModalModel, aero: AerodynamicModel, rho: float, w: floa
 
 def aeroelastic_eigenvalues(model: ModalModel, aero: AerodynamicModel, air_density: float, speed: float,
                             guesses: np.ndarray, shapes: np.ndarray | None = None, tolerance: float = 1e-10,
-                            max_iterations: int = 200) -> tuple[np.ndarray, np.ndarray]:
+                            max_iterations: int = 200) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """p-k eigenvalue s_r and modal shape (complex N-vector of modal amplitudes) of each mode at wind
     speed V, iterating on frequency from ``guesses`` (one per mode: the previous speed's eigenvalues, or
     i w_r at the first speed).
@@ -81,16 +81,24 @@ def aeroelastic_eigenvalues(model: ModalModel, aero: AerodynamicModel, air_densi
     sqrt(m_i) q_i, columns of ``shapes``; identity at the start) is taken; nearest eigenvalue breaks
     ties.  Tracking by eigenvalue distance alone lets modes with close frequencies (S-V5, S-T1, SS-V5
     of the Great Belt) collapse onto one branch and miss the flutter branch.
+
+    The trial frequency is kept inside the aerodynamic model's Omega range (a table is never
+    extrapolated); the third return value flags the modes whose iteration wanted to leave it (their
+    eigenvalue is then not a p-k solution and the caller discards it).
     """
     n = model.n_modes
     shapes = np.eye(n, dtype=np.complex128) if shapes is None else np.asarray(shapes, dtype=np.complex128)
     out, out_shapes = np.empty(n, dtype=np.complex128), np.empty((n, n), dtype=np.complex128)
     w_floor = 1e-6 * model.angular_frequencies.min()
+    o_lo, o_hi = aero.omega_range
+    w_lo = max(w_floor, o_lo * speed / model.deck_width_m)      # Omega range of the model, as w at this V
+    w_hi = o_hi * speed / model.deck_width_m
+    outside = np.zeros(n, dtype=bool)
     scale = np.sqrt(model.modal_masses)[:, None]   # shapes compared in mass-normalised coordinates
     for r, s_prev in enumerate(np.asarray(guesses, dtype=np.complex128)):
         ref = shapes[:, r] / np.linalg.norm(shapes[:, r])
         s = s_prev
-        w = max(abs(s.imag), w_floor)
+        w = min(max(abs(s.imag), w_lo), w_hi)
         for _ in range(max_iterations):
             lam, vec = np.linalg.eig(_state_matrix(model, aero, air_density, w, speed))
             keep = lam.imag >= 0.0
@@ -101,7 +109,7 @@ def aeroelastic_eigenvalues(model: ModalModel, aero: AerodynamicModel, air_densi
             score = mac - 1e-6 * np.abs(lam - s_prev) / max(abs(s_prev), w_floor)
             i = int(np.argmax(score))
             s, phi = lam[i], X[:, i]
-            w_new = max(s.imag, w_floor)
+            w_new = min(max(s.imag, w_lo), w_hi)
             change = abs(w_new - w) / w
             if change <= tolerance:
                 break
@@ -110,7 +118,8 @@ def aeroelastic_eigenvalues(model: ModalModel, aero: AerodynamicModel, air_densi
             raise ConvergenceError(f"p-k frequency iteration, mode {model.labels[r]} at V = {speed:g} m/s",
                                    max_iterations, change, tolerance)
         out[r], out_shapes[:, r] = s, phi
-    return out, out_shapes
+        outside[r] = (s.imag < w_lo and w_lo > w_floor) or s.imag > w_hi
+    return out, out_shapes, outside
 
 
 def _damping(s: np.ndarray) -> np.ndarray:
@@ -137,11 +146,12 @@ def pk_sweep(model: ModalModel, aero: AerodynamicModel, air_density: float, max_
     s, phi = 1j * model.angular_frequencies, np.eye(model.n_modes, dtype=np.complex128)
     eig = np.empty((speeds.size, model.n_modes), dtype=np.complex128)
     shapes = np.empty((speeds.size, model.n_modes, model.n_modes), dtype=np.complex128)
+    outside = np.zeros((speeds.size, model.n_modes), dtype=bool)
     for n, V in enumerate(speeds):
-        s, phi = aeroelastic_eigenvalues(model, aero, air_density, V, s, phi, tolerance)
-        eig[n], shapes[n] = s, phi
-    zeta = _damping(eig)
-    freq = eig.imag / (2 * np.pi)
+        s, phi, off = aeroelastic_eigenvalues(model, aero, air_density, V, s, phi, tolerance)
+        eig[n], shapes[n], outside[n] = s, phi, off
+    zeta = np.where(outside, np.nan, _damping(eig))        # NaN: outside the aerodynamic model's range
+    freq = np.where(outside, np.nan, eig.imag / (2 * np.pi))
     result = dict(labels=model.labels, speed_m_s=speeds, frequency_hz=freq, damping_ratio=zeta,
                   max_speed_searched_m_s=float(v_hi))
     crossing = np.flatnonzero((zeta[:-1] > 0.0) & (zeta[1:] <= 0.0))  # flat index over (n_V-1, N)
@@ -155,8 +165,11 @@ def pk_sweep(model: ModalModel, aero: AerodynamicModel, air_density: float, max_
             break                                        # any later divergence is beyond flutter anyway
 
         def zeta_r(V: float, n0=n0, r=r) -> float:
-            s_r = aeroelastic_eigenvalues(model, aero, air_density, V, eig[n0], shapes[n0], tolerance)[0][r]
-            return float(_damping(np.array([s_r]))[0])
+            s_all, _, off = aeroelastic_eigenvalues(model, aero, air_density, V, eig[n0], shapes[n0], tolerance)
+            if off[r]:
+                raise InputError("flutter.reduced_frequency", float(s_all[r].imag * model.deck_width_m / V),
+                                 "outside the aerodynamic model's range while refining the p-k crossing")
+            return float(_damping(s_all[r:r + 1])[0])
 
         V_c = brentq(zeta_r, speeds[n0], speeds[n0 + 1], xtol=1e-12 * speeds[n0 + 1], rtol=1e-12)
         s_c = aeroelastic_eigenvalues(model, aero, air_density, V_c, eig[n0], shapes[n0], tolerance)[0][r]

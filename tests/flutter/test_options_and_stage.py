@@ -103,3 +103,39 @@ def test_stage_reports_no_flutter_below_the_maximum_speed():
     out = run(_scenario(flutter=FlutterOptions(max_speed_m_s=20.0, multimode=False)), {}, RunOptions(quick=True))
     assert out.summary["flutter.flutter"] == 0 and out.summary["flutter.critical_speed_m_s"] == "none"
     assert "No flutter" in out.report and "20 m/s" in out.report
+
+
+def test_stage_reads_an_frf_table_relative_to_the_scenario_file(tmp_path):
+    from bridge.flutter.derivatives import FRF
+
+    omega, speed = np.linspace(0.05, 40.0, 800), np.array([5.0, 200.0])
+    Om, V = np.meshgrid(omega, speed, indexing="ij")
+    h = Theodorsen().frf(Om, V)
+    with h5py.File(tmp_path / "aero.h5", "w") as f:
+        g = f.create_group("frf")
+        g["reduced_frequency"], g["speed_m_s"] = omega, speed
+        for name in FRF._fields:
+            g[name] = getattr(h, name)
+    table = FlutterOptions.from_mapping({"aerodynamics": "table", "table_path": "aero.h5", "table_group": "frf",
+                                         "max_speed_m_s": 120.0, "min_speed_m_s": 10.0}, "flutter")
+    direct = run(_scenario(flutter=FlutterOptions(max_speed_m_s=120.0, min_speed_m_s=10.0)), {},
+                 RunOptions(quick=True))
+    tabled = run(_scenario(flutter=table, source_path=str(tmp_path / "plate.toml")), {}, RunOptions(quick=True))
+    v_direct, v_table = direct.summary["flutter.critical_speed_m_s"], tabled.summary["flutter.critical_speed_m_s"]
+    assert abs(v_table / v_direct - 1) < 0.005
+    assert abs(tabled.summary["flutter.multimode_critical_speed_m_s"] / v_direct - 1) < 0.005
+
+
+def test_derivative_csv_header_and_cells_are_checked(tmp_path):
+    from bridge.flutter.aerodynamics import DerivativeTable
+
+    good = tmp_path / "d.csv"
+    good.write_text("K,H1,H2,H3,H4,A1,A2,A3,A4\n0.5,1,2,3,4,5,6,7,8\n1.0,1,2,3,4,5,6,7,8\n")
+    assert DerivativeTable.from_csv(good).omega_range == (0.5, 1.0)
+    for text in ("K,H1,H2\n0.5,1,2\n1.0,1,2\n", "K,H1,H2,H3,H4,A1,A2,A3,A4\n0.5,1,2,3,4,5,6,7,x\n1,1,2,3,4,5,6,7,8\n"):
+        bad = tmp_path / "bad.csv"
+        bad.write_text(text)
+        with pytest.raises(InputError):
+            DerivativeTable.from_csv(bad)
+    with pytest.raises(InputError, match="derivatives_path"):
+        DerivativeTable.from_csv(tmp_path / "missing.csv")
