@@ -53,6 +53,8 @@ class RunOptions:
 # Stage name -> ("module:function", stages it needs).  Order here is the run order.
 STAGES: dict[str, tuple[str, tuple[str, ...]]] = {
     "cable": ("bridge.cable_stage:run", ()),
+    "fem": ("bridge.structure.stage:run", ("cable",)),
+    "flutter": ("bridge.flutter.stage:run", ("fem",)),
 }
 
 
