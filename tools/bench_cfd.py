@@ -1,0 +1,183 @@
+"""Benchmark of the laminar CFD step: cell-steps per second of the whole step and of each part,
+beside the NumPy implementation of the same step and this machine's memory-bandwidth roofline.
+
+    python tools/bench_cfd.py                       # 256x128, 512x256, 1024x512
+    python tools/bench_cfd.py --sizes 1024x512 --repeats 7 --json out/bench_cfd.json
+
+Method: compile and 3 warm-up steps excluded; each figure is the median over ``--repeats`` timed
+blocks (``--steps`` steps each for the full step; per-part timings use the same state). Launches
+are synchronous on the CPU; on CUDA the tool synchronises before stopping the clock. The flow:
+uniform inflow 1 + a smooth disturbance, convective outflow, slip sides, van Leer advection,
+Heun (2 stages), no body (a body adds work only in its bounding box).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import sys
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import warp as wp
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from bridge.cfd import CartesianGrid, FlowConfig, Simulation  # noqa: E402
+from bridge.cfd.grids import GHOST  # noqa: E402
+from bridge.cfd.launch import ROW0  # noqa: E402
+from bridge.cfd.reference_numpy import NumpyFlow  # noqa: E402
+from kernels import cfd as kc  # noqa: E402
+
+# Bytes moved per cell per STAGE, assuming each array is streamed once (stencil neighbours in cache):
+BYTES_PER_CELL_STAGE = {
+    "predict_u": 6 * 8,   # read u, v, p, nu, u0; write u*
+    "predict_v": 6 * 8,
+    "divergence": 3 * 8,  # read u*, v*; write rhs
+    "poisson": 6 * 16,    # forward + inverse DCT along two axes, ~3 read+write passes each, + scaling
+    "project": 7 * 8,     # read u*, v*, phi, p; write u, v, p
+}
+
+
+def _sync(device):
+    if not wp.get_device(device).is_cpu:
+        wp.synchronize_device(device)
+
+
+def make_case(nx: int, ny: int, threads: int, device=None, pressure="full"):
+    grid = CartesianGrid.uniform(nx, ny, (0.0, 2.0 * nx / ny), (-1.0, 1.0))
+    cfg = FlowConfig(nu=1e-3, advection="vanleer", threads=threads, pressure=pressure)
+    sim = Simulation(grid, cfg, device=device)
+    x, y = np.meshgrid(grid.x_faces, grid.y_centres)
+    u = 1.0 + 0.1 * np.sin(3 * x) * np.cos(2 * y)
+    xv, yv = np.meshgrid(grid.x_centres, grid.y_faces)
+    v = 0.1 * np.cos(2 * xv) * np.sin(np.pi * (yv + 1) / 2)
+    sim.set_state(u, v)
+    return sim
+
+
+def _median_time(fn, repeats, inner, device):
+    times = []
+    for _ in range(repeats):
+        _sync(device)
+        t0 = time.perf_counter()
+        for _ in range(inner):
+            fn()
+        _sync(device)
+        times.append((time.perf_counter() - t0) / inner)
+    return statistics.median(times)
+
+
+def bench_warp(nx, ny, threads, repeats, steps, device=None):
+    sim = make_case(nx, ny, threads, device)
+    dt = 0.2 * sim.grid.dx
+    for _ in range(3):
+        sim.step(dt)  # compile + warm-up
+    cells = nx * ny
+    out = {"step": cells / _median_time(lambda: sim.step(dt), repeats, steps, device)}
+    g = GHOST
+    L = sim.L
+    parts = {
+        "predict_u": lambda: L.rows(kc.predict_u, ny, g, [sim.u, sim.v, sim._p_zero, sim.nu, sim.u, sim.u_star,
+                                                          sim.hy_c, sim.hy_f, sim.grid.dx, dt, 0.5, 0.5,
+                                                          g + 1, g + nx, ROW0, sim.scheme]),
+        "predict_v": lambda: L.rows(kc.predict_v, ny - 1, g + 1, [sim.u, sim.v, sim._p_zero, sim.nu, sim.v,
+                                                                  sim.v_star, sim.hy_c, sim.hy_f, sim.grid.dx,
+                                                                  dt, 0.5, 0.5, g, g + nx, ROW0, sim.scheme]),
+        "boundaries": lambda: sim.bc.set_normal_faces(sim.u, sim.u, sim.u_star, sim.t, dt, 0.5, 0.5),
+        "divergence": lambda: L.rows(kc.divergence, ny, 0, [sim.u_star, sim.v_star, sim.hy_c, sim.grid.dx,
+                                                            1.0, g, nx, ROW0, sim.rhs]),
+        "poisson": lambda: sim.poisson.solve(sim._rhs_np, out=sim._phi_np) if sim._host
+        else sim.phi.assign(sim.poisson.solve(sim.rhs.numpy())),
+        "project": lambda: L.rows(kc.project, ny, 0, [sim.u_star, sim.v_star, sim.phi, sim.hy_f, sim.grid.dx,
+                                                      0.5 * dt, g, nx, ny, ROW0, sim.u_stage, sim.v_stage,
+                                                      sim.p]),
+        "ghosts": lambda: sim.bc.fill_ghosts(sim.u_stage, sim.v_stage),
+    }
+    for name, fn in parts.items():
+        fn()
+        out[name] = cells / _median_time(fn, repeats, steps, device)  # per call (one stage)
+    return out
+
+
+def bench_numpy(nx, ny, repeats, steps):
+    grid = CartesianGrid.uniform(nx, ny, (0.0, 2.0 * nx / ny), (-1.0, 1.0))
+    ref = NumpyFlow(grid, FlowConfig(nu=1e-3, advection="vanleer"))
+    sim = make_case(nx, ny, 1)
+    for name in "uvp":
+        getattr(ref, name)[...] = getattr(sim, name).numpy()
+    dt = 0.2 * grid.dx
+    ref.step(dt)
+    return nx * ny / _median_time(lambda: ref.step(dt), repeats, steps, None)
+
+
+def bandwidth(n_bytes=256 * 2**20, repeats=5):
+    """memcpy (numpy copyto, one thread) and STREAM triad a = b + s c on two threads, GB/s.
+    Bytes counted: copy 2 N, triad 3 N (write-allocate not counted, as STREAM does)."""
+    n = n_bytes // 8
+    a, b, c = np.zeros(n), np.ones(n), np.full(n, 2.0)
+    copy = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        np.copyto(a, b)
+        copy.append(2 * n_bytes / (time.perf_counter() - t0))
+
+    def triad(lo, hi):
+        np.multiply(c[lo:hi], 3.0, out=a[lo:hi])
+        np.add(a[lo:hi], b[lo:hi], out=a[lo:hi])  # two passes over a: counted below
+
+    tri = []
+    for _ in range(repeats):
+        ths = [threading.Thread(target=triad, args=(k * n // 2, (k + 1) * n // 2)) for k in range(2)]
+        t0 = time.perf_counter()
+        for th in ths:
+            th.start()
+        for th in ths:
+            th.join()
+        # NumPy triad in two calls moves 5 N (read c, write a; read a, b, write a)
+        tri.append(5 * n_bytes / (time.perf_counter() - t0))
+    return statistics.median(copy) / 1e9, statistics.median(tri) / 1e9
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--sizes", default="256x128,512x256,1024x512")
+    ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--repeats", type=int, default=5)
+    ap.add_argument("--steps", type=int, default=5, help="steps per timed block")
+    ap.add_argument("--numpy-steps", type=int, default=2)
+    ap.add_argument("--device", default=None)
+    ap.add_argument("--json", default=None)
+    args = ap.parse_args(argv)
+    wp.config.quiet = True
+    wp.init()
+    copy_bw, triad_bw = bandwidth()
+    bytes_step = 2 * sum(BYTES_PER_CELL_STAGE.values())
+    bw = triad_bw * 1e9
+    print(f"memory bandwidth: memcpy {copy_bw:.1f} GB/s, 2-thread triad {triad_bw:.1f} GB/s; "
+          f"~{bytes_step} B per cell-step -> roofline {bw / bytes_step / 1e6:.1f} M cell-steps/s (triad)")
+    results = {"bandwidth_GBs": {"memcpy": copy_bw, "triad_2threads": triad_bw},
+               "bytes_per_cell_step": bytes_step, "sizes": {}}
+    for size in args.sizes.split(","):
+        nx, ny = (int(s) for s in size.lower().split("x"))
+        w = bench_warp(nx, ny, args.threads, args.repeats, args.steps, args.device)
+        npy = bench_numpy(nx, ny, max(3, args.repeats // 2), args.numpy_steps)
+        roof = bw / bytes_step
+        results["sizes"][size] = {"warp": w, "numpy_step": npy, "roofline_step": roof}
+        print(f"\n{nx}x{ny} ({nx * ny / 1e6:.3f} M cells), threads={args.threads}")
+        print(f"  full step (2 stages)   {w['step'] / 1e6:8.2f} M cell-steps/s   "
+              f"NumPy same step {npy / 1e6:6.3f}  -> speed-up {w['step'] / npy:5.1f}x   "
+              f"roofline {roof / 1e6:6.1f} -> {w['step'] / roof:5.1%}")
+        for name in ("predict_u", "predict_v", "boundaries", "divergence", "poisson", "project", "ghosts"):
+            print(f"  {name:<22} {w[name] / 1e6:8.1f} M cells/s per call  ({1e9 / w[name]:6.2f} ns/cell)")
+    if args.json:
+        Path(args.json).parent.mkdir(parents=True, exist_ok=True)
+        Path(args.json).write_text(json.dumps(results, indent=2))
+    return results
+
+
+if __name__ == "__main__":
+    main()

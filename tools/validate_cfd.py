@@ -1,0 +1,190 @@
+"""Validation of the laminar CFD core against published numbers (VALIDATION.md); not in the test run.
+
+    python tools/validate_cfd.py cylinder --re 20 --ppd 20 30 --t-end 40
+    python tools/validate_cfd.py cylinder --re 100 --ppd 20 --t-end 150
+    python tools/validate_cfd.py dfg --ppd 16 32 64 --t-end 6
+
+Cylinder (diameter D = 1, U = 1): box x in [-10, 20] D (uniform in x), y in [-15, 15] D stretched
+outside |y| < 1.5 D (growth 5 %), uniform inflow, convective outflow, slip sides; blockage
+D/H = 1/30. Reported: C_D = 2 F_x/(rho U^2 D) (mean over whole shedding periods when unsteady),
+recirculation length L_w/D (last zero of u on the wake centreline, from the rear of the cylinder),
+Strouhal number from the zero up-crossings of C_L over the last ``--window`` time units.
+DFG 2D-1 (Schaefer and Turek 1996): channel 2.2 x 0.41, D = 0.1 at (0.2, 0.2), nu = 1e-3, parabolic
+inflow U_max = 0.3, no-slip walls; c_D, c_L on U_mean = 0.2; pressure difference between the front
+and rear points of the cylinder, each linearly extrapolated from the two nearest fluid cells on
+the line y = 0.2. ``--ppd``: grid cells per diameter. Results are appended to ``--out`` as JSON lines.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+import warp as wp  # noqa: E402
+
+from bridge.cfd import (BoundaryConditions, CartesianGrid, FlowConfig, ForceHistory, ImmersedBody,  # noqa: E402
+                        NaNMonitor, Simulation, Stationary, circle, run, stretched_faces)
+
+BANDS = {  # VALIDATION.md
+    20: {"C_D": (2.00, 2.09), "L_w/D": (0.91, 0.94)},
+    40: {"C_D": (1.50, 1.58), "L_w/D": (2.13, 2.35)},
+    100: {"St": (0.160, 0.168), "C_D": (1.33, 1.40)},
+    "dfg": {"c_D": (5.57, 5.59), "c_L": (0.0104, 0.0110), "dp": (0.1172, 0.1176)},
+}
+
+
+def _wake_length(sim, x_rear, y_axis):
+    """Distance from x_rear to the last point where the centreline u changes sign (0 if none)."""
+    g = sim.grid
+    u, _, _ = sim.interior()
+    yc = g.y_centres
+    j = int(np.searchsorted(yc, y_axis))
+    w = (y_axis - yc[j - 1]) / (yc[j] - yc[j - 1])
+    line = (1 - w) * u[j - 1] + w * u[j]
+    x = g.x_faces
+    m = x > x_rear
+    xs, us = x[m], line[m]
+    neg = np.nonzero(us < 0)[0]
+    if neg.size == 0:
+        return 0.0
+    k = neg[-1]
+    x0 = xs[k] + (xs[k + 1] - xs[k]) * us[k] / (us[k] - us[k + 1])
+    return float(x0 - x_rear)
+
+
+def _strouhal(t, cl, window):
+    sel = t > t[-1] - window
+    t, cl = t[sel], cl[sel] - cl[sel].mean()
+    up = np.nonzero((cl[:-1] < 0) & (cl[1:] >= 0))[0]
+    if up.size < 3:
+        return float("nan"), None
+    tc = t[up] - cl[up] * (t[up + 1] - t[up]) / (cl[up + 1] - cl[up])
+    period = np.diff(tc).mean()
+    return float(1.0 / period), (tc[0], tc[-1])
+
+
+def cylinder(re, ppd, t_end, window, threads, scheme):
+    h = 1.0 / ppd
+    nx = int(round(30 / h))
+    grid = CartesianGrid(np.linspace(-10.0, 20.0, nx + 1), stretched_faces(-15.0, 15.0, (-1.5, 1.5), h, 1.05))
+    cfg = FlowConfig(nu=1.0 / re, advection=scheme, cfl=0.5, fourier=0.2, threads=threads,
+                     bc=BoundaryConditions(u_inf=1.0))
+    sim = Simulation(grid, cfg)
+    sim.bodies = [ImmersedBody(circle(1.0), Stationary(0.0, 0.0), grid, sim.L)]
+    sim.set_state(u=1.0)
+    if re >= 60:  # trigger shedding: a short asymmetric rotation pulse is cleaner, a tilted start suffices
+        sim.set_state(u=1.0, v=0.05 * np.exp(-((grid.x_centres[None, :] - 2) ** 2)) * np.ones((grid.ny + 1, 1)))
+    hist, nan = ForceHistory(), NaNMonitor(every=200)
+    t0 = time.perf_counter()
+    run(sim, t_end, [hist, nan])
+    wall = time.perf_counter() - t0
+    t, f = hist.array()
+    cd, cl = 2 * f[:, 0, 0], 2 * f[:, 0, 1]
+    out = {"case": f"cylinder Re={re}", "ppd": ppd, "cells": grid.nx * grid.ny, "nx": grid.nx, "ny": grid.ny,
+           "t_end": float(sim.t), "steps": sim.n_steps, "wall_s": wall, "blockage": 1.0 / 30,
+           "advection": scheme}
+    if re < 50:
+        last = t > t[-1] - 5
+        out["C_D"] = float(cd[-1])
+        out["C_D_drift_per_time"] = float(np.polyfit(t[last], cd[last], 1)[0])
+        out["L_w/D"] = _wake_length(sim, 0.5, 0.0)
+    else:
+        st, span = _strouhal(t, cl, window)
+        out["St"] = st
+        if span is not None:
+            sel = (t >= span[0]) & (t <= span[1])
+            out["C_D"] = float(cd[sel].mean())
+            out["C_L_amplitude"] = float(np.abs(cl[sel]).max())
+    out["band"] = BANDS.get(re)
+    return out
+
+
+def _line_pressure(sim, x_target, side, y_line, body_phi):
+    """Pressure at (x_target, y_line) extrapolated from the two nearest fluid cells on one side."""
+    g = sim.grid
+    _, _, p = sim.interior()
+    yc = g.y_centres
+    j = int(np.searchsorted(yc, y_line))
+    w = (y_line - yc[j - 1]) / (yc[j] - yc[j - 1])
+    line = (1 - w) * p[j - 1] + w * p[j]
+    xc = g.x_centres
+    fluid = body_phi(xc, y_line) > 0.5 * g.dx
+    idx = np.nonzero(fluid & ((xc < x_target) if side < 0 else (xc > x_target)))[0]
+    k = idx[-2:] if side < 0 else idx[:2]
+    x1, x2 = xc[k]
+    p1, p2 = line[k]
+    return float(p1 + (p2 - p1) * (x_target - x1) / (x2 - x1))
+
+
+def dfg(ppd, t_end, threads, scheme):
+    d, h_ch, length, nu, umax = 0.1, 0.41, 2.2, 1e-3, 0.3
+    h = d / ppd
+    nx = int(round(length / h))
+    ny = int(round(h_ch / h))
+    grid = CartesianGrid.uniform(nx, ny, (0.0, length), (0.0, h_ch))
+
+    def profile(y, t):
+        return 4 * umax * y * (h_ch - y) / h_ch ** 2
+
+    bc = BoundaryConditions(left="inflow", right="outflow", bottom="noslip", top="noslip", inflow_profile=profile)
+    cfg = FlowConfig(nu=nu, advection=scheme, cfl=0.5, fourier=0.2, threads=threads, bc=bc)
+    sim = Simulation(grid, cfg)
+    sim.bodies = [ImmersedBody(circle(d), Stationary(0.2, 0.2), grid, sim.L)]
+    yc = grid.y_centres
+    sim.set_state(u=np.broadcast_to(profile(yc, 0)[:, None], (ny, nx + 1)))
+    hist, nan = ForceHistory(), NaNMonitor(every=200)
+    t0 = time.perf_counter()
+    run(sim, t_end, [hist, nan])
+    wall = time.perf_counter() - t0
+    t, f = hist.array()
+    um = 2 * umax / 3
+    scale = 2 / (um ** 2 * d)
+    last = t > t[-1] - 1.0
+
+    def phi(x, y):
+        return np.hypot(x - 0.2, y - 0.2) - d / 2
+
+    dp = _line_pressure(sim, 0.15, -1, 0.2, phi) - _line_pressure(sim, 0.25, +1, 0.2, phi)
+    return {"case": "DFG 2D-1", "ppd": ppd, "cells": nx * ny, "nx": nx, "ny": ny, "t_end": float(sim.t),
+            "steps": sim.n_steps, "wall_s": wall, "blockage": d / h_ch, "advection": scheme,
+            "c_D": float(scale * f[-1, 0, 0]), "c_L": float(scale * f[-1, 0, 1]), "dp": dp,
+            "c_D_drift_per_time": float(np.polyfit(t[last], scale * f[last, 0, 0], 1)[0]),
+            "band": BANDS["dfg"]}
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("case", choices=["cylinder", "dfg"])
+    ap.add_argument("--re", type=float, default=20)
+    ap.add_argument("--ppd", type=int, nargs="+", default=[20])
+    ap.add_argument("--t-end", type=float, default=40.0)
+    ap.add_argument("--window", type=float, default=40.0, help="time window for St and mean C_D")
+    ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--advection", default="vanleer")
+    ap.add_argument("--out", default="out/validation_cfd.jsonl")
+    args = ap.parse_args(argv)
+    wp.config.quiet = True
+    results = []
+    for ppd in args.ppd:
+        if args.case == "cylinder":
+            r = cylinder(int(args.re), ppd, args.t_end, args.window, args.threads, args.advection)
+        else:
+            r = dfg(ppd, args.t_end, args.threads, args.advection)
+        r["command"] = "python tools/validate_cfd.py " + " ".join(argv if argv is not None else sys.argv[1:])
+        print(json.dumps(r), flush=True)
+        Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+        with open(args.out, "a") as fh:
+            fh.write(json.dumps(r) + "\n")
+        results.append(r)
+    return results
+
+
+if __name__ == "__main__":
+    main()
