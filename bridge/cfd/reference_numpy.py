@@ -23,12 +23,13 @@ def _limited(qu, qc, qd, duc, dcd, w, scheme):
     dq = qd - qc
     if scheme == 0:
         return qc + w * dq
-    num = (qc - qu) * dcd
-    den = dq * duc
-    ok = num * den > 0
-    r = np.where(ok, num / np.where(ok, den, 1.0), 0.0)
-    psi = np.where(ok, (r + np.abs(r)) / (1.0 + np.abs(r)), 0.0)
-    return qc + psi * w * dq
+    # van Leer: psi(r) dq with r = ((qc - qu)/duc) / (dq/dcd), psi = (r + |r|)/(1 + |r|)
+    a = (qc - qu) / duc
+    b = dq / dcd
+    ok = a * b > 0
+    r = np.where(ok, a / np.where(ok, b, 1.0), 0.0)
+    psi = (r + np.abs(r)) / (1.0 + np.abs(r))
+    return qc + w * psi * dq
 
 
 def _flux(vel, qm2, qm1, qp1, qp2, dm, d0, dp, wm, scheme):
