@@ -147,3 +147,41 @@ def test_models_frequencies_fall_with_span():
         f[name] = (r.frequency("S-V1"), r.frequency("S-T1"))
     assert f["model_c"][0] < 0.8 * f["great_belt"][0]
     assert f["model_c"][1] < 0.8 * f["great_belt"][1]
+
+
+def test_assembled_mass_is_the_bridge_mass(great_belt):
+    """A rigid translation of the unconstrained model: u^T M u = total mass of girder, cables, hangers, pylons."""
+    s, _, r = great_belt
+    m, M = r.model, r.assembled.mass
+    length = np.linalg.norm(m.elements.xb - m.elements.xa, axis=1)
+    expected = float(np.sum(m.elements.props[:, 4] * length))
+    from bridge.structure.model import GROUPS
+
+    in_girder = m.group == GROUPS.index("girder")
+    assert np.sum(m.elements.props[in_girder, 4] * length[in_girder]) == pytest.approx(
+        s.girder.mass_per_length_kg_m * m.deck_length_m, rel=1e-12)
+    legs = np.isin(m.group, [GROUPS.index("pylon_lower_leg"), GROUPS.index("pylon_upper_leg")])
+    leg_height = length[legs].sum() / 4   # four legs, foundation to saddle
+    assert leg_height == pytest.approx(s.geometry.pylon_height_m, rel=1e-12)
+    for d in range(3):
+        u = np.zeros(M.shape[0])
+        u[d::6] = 1.0
+        assert u @ (M @ u) == pytest.approx(expected, rel=1e-12)
+
+
+def test_shift_invert_matches_dense_solver():
+    """lowest_modes against scipy.linalg.eigh on a small random SPD pencil."""
+    import scipy.linalg as sla
+    import scipy.sparse as sp
+
+    from bridge.structure.eigen import lowest_modes
+
+    rng = np.random.default_rng(3)
+    a = rng.normal(size=(60, 60))
+    K = a @ a.T + 60 * np.eye(60)
+    b = rng.normal(size=(60, 60))
+    M = b @ b.T / 60 + np.eye(60)
+    f, vec = lowest_modes(sp.csr_matrix(K), sp.csr_matrix(M), 8)
+    w2 = sla.eigh(K, M, eigvals_only=True)[:8]
+    assert np.allclose((2 * np.pi * f) ** 2, w2, rtol=1e-10)
+    assert np.allclose(vec.T @ M @ vec, np.eye(8), atol=1e-8)
