@@ -64,34 +64,46 @@ def upwind_flux(vel: wp.float64, q_m2: wp.float64, q_m1: wp.float64, q_p1: wp.fl
 
 
 @wp.kernel
+def yflux_u(u: wp.array2d(dtype=wp.float64), v: wp.array2d(dtype=wp.float64),
+            nu: wp.array2d(dtype=wp.float64), hy_c: wp.array(dtype=wp.float64),
+            hy_f: wp.array(dtype=wp.float64), dx: wp.float64, i_lo: int, i_hi: int, row0: int, scheme: int,
+            flux: wp.array2d(dtype=wp.float64)):
+    """y-flux of x-momentum (advective - viscous) at the corners of v-face row J, u columns I:
+    computed once per corner and shared by the u-faces above and below (``predict_u``)."""
+    J = row0 + wp.tid()
+    half = wp.float64(0.5)
+    one = wp.float64(1.0)
+    ihf = one / hy_f[J]
+    idx = one / dx
+    rm = hy_f[J] / hy_f[J - 1]
+    rp = hy_f[J] / hy_f[J + 1]
+    w = half * hy_c[J - 1] * ihf
+    for I in range(i_lo, i_hi):
+        vc = half * (v[J, I - 1] + v[J, I])
+        nuc = wp.float64(0.25) * (nu[J - 1, I - 1] + nu[J - 1, I] + nu[J, I - 1] + nu[J, I])
+        flux[J, I] = upwind_flux(vc, u[J - 2, I], u[J - 1, I], u[J, I], u[J + 1, I], rm, rp, w, scheme) \
+            - nuc * ((u[J, I] - u[J - 1, I]) * ihf + (v[J, I] - v[J, I - 1]) * idx)
+
+
+@wp.kernel
 def predict_u(u: wp.array2d(dtype=wp.float64), v: wp.array2d(dtype=wp.float64),
               p: wp.array2d(dtype=wp.float64), nu: wp.array2d(dtype=wp.float64),
               u0: wp.array2d(dtype=wp.float64), out: wp.array2d(dtype=wp.float64),
-              hy_c: wp.array(dtype=wp.float64), hy_f: wp.array(dtype=wp.float64),
+              hy_c: wp.array(dtype=wp.float64), gflux: wp.array2d(dtype=wp.float64),
               dx: wp.float64, dt: wp.float64, a: wp.float64, b: wp.float64,
               i_lo: int, i_hi: int, row0: int, scheme: int):
     """out = a*u0 + b*(u + dt*(-div(u u) + div(2 nu S)_x - dp/dx)) on u-faces of one row.
 
     Conservative advection (limited upwind-biased) and the full variable-viscosity stress
-    nu (grad u + grad u^T) so an eddy viscosity nu_t(x, y) plugs in through ``nu``.
-    Row metrics are inverted once per row; the x-flux is carried along the row.
+    nu (grad u + grad u^T) so an eddy viscosity nu_t(x, y) plugs in through ``nu``. The x-flux is
+    carried along the row; the y-fluxes come from ``yflux_u`` (rows J and J+1 of ``gflux``).
     """
     J = row0 + wp.tid()
     half = wp.float64(0.5)
     one = wp.float64(1.0)
     two = wp.float64(2.0)
-    quarter = wp.float64(0.25)
     idx = one / dx
     ihc = one / hy_c[J]
-    ihft = one / hy_f[J + 1]
-    ihfb = one / hy_f[J]
-    # limiter spacing ratios and interpolation weights of the top (face row J+1) and bottom (J) corners
-    rtm = hy_f[J + 1] / hy_f[J]
-    rtp = hy_f[J + 1] / hy_f[J + 2]
-    wt = half * hy_c[J] * ihft
-    rbm = hy_f[J] / hy_f[J - 1]
-    rbp = hy_f[J] / hy_f[J + 1]
-    wb = half * hy_c[J - 1] * ihfb
     I = i_lo
     uc = half * (u[J, I - 1] + u[J, I])
     fl = upwind_flux(uc, u[J, I - 2], u[J, I - 1], u[J, I], u[J, I + 1], one, one, half, scheme) \
@@ -100,17 +112,26 @@ def predict_u(u: wp.array2d(dtype=wp.float64), v: wp.array2d(dtype=wp.float64),
         uc = half * (u[J, I] + u[J, I + 1])
         fr = upwind_flux(uc, u[J, I - 1], u[J, I], u[J, I + 1], u[J, I + 2], one, one, half, scheme) \
             - two * nu[J, I] * (u[J, I + 1] - u[J, I]) * idx
-        vt = half * (v[J + 1, I - 1] + v[J + 1, I])
-        nut = quarter * (nu[J, I - 1] + nu[J, I] + nu[J + 1, I - 1] + nu[J + 1, I])
-        gt = upwind_flux(vt, u[J - 1, I], u[J, I], u[J + 1, I], u[J + 2, I], rtm, rtp, wt, scheme) \
-            - nut * ((u[J + 1, I] - u[J, I]) * ihft + (v[J + 1, I] - v[J + 1, I - 1]) * idx)
-        vb = half * (v[J, I - 1] + v[J, I])
-        nub = quarter * (nu[J - 1, I - 1] + nu[J - 1, I] + nu[J, I - 1] + nu[J, I])
-        gb = upwind_flux(vb, u[J - 2, I], u[J - 1, I], u[J, I], u[J + 1, I], rbm, rbp, wb, scheme) \
-            - nub * ((u[J, I] - u[J - 1, I]) * ihfb + (v[J, I] - v[J, I - 1]) * idx)
-        rhs = -(fr - fl) * idx - (gt - gb) * ihc - (p[J, I] - p[J, I - 1]) * idx
+        rhs = -(fr - fl) * idx - (gflux[J + 1, I] - gflux[J, I]) * ihc - (p[J, I] - p[J, I - 1]) * idx
         out[J, I] = a * u0[J, I] + b * (u[J, I] + dt * rhs)
         fl = fr
+
+
+@wp.kernel
+def yflux_v(v: wp.array2d(dtype=wp.float64), nu: wp.array2d(dtype=wp.float64),
+            hy_c: wp.array(dtype=wp.float64), i_lo: int, i_hi: int, row0: int, scheme: int,
+            flux: wp.array2d(dtype=wp.float64)):
+    """y-flux of y-momentum (advective - viscous) at the cell centres of row J, shared by the
+    v-faces J and J+1 (``predict_v``)."""
+    J = row0 + wp.tid()
+    half = wp.float64(0.5)
+    ihc = wp.float64(1.0) / hy_c[J]
+    rm = hy_c[J] / hy_c[J - 1]
+    rp = hy_c[J] / hy_c[J + 1]
+    for I in range(i_lo, i_hi):
+        vc = half * (v[J, I] + v[J + 1, I])
+        flux[J, I] = upwind_flux(vc, v[J - 1, I], v[J, I], v[J + 1, I], v[J + 2, I], rm, rp, half, scheme) \
+            - wp.float64(2.0) * nu[J, I] * (v[J + 1, I] - v[J, I]) * ihc
 
 
 @wp.kernel
@@ -118,25 +139,20 @@ def predict_v(u: wp.array2d(dtype=wp.float64), v: wp.array2d(dtype=wp.float64),
               p: wp.array2d(dtype=wp.float64), nu: wp.array2d(dtype=wp.float64),
               v0: wp.array2d(dtype=wp.float64), out: wp.array2d(dtype=wp.float64),
               hy_c: wp.array(dtype=wp.float64), hy_f: wp.array(dtype=wp.float64),
+              gflux: wp.array2d(dtype=wp.float64),
               dx: wp.float64, dt: wp.float64, a: wp.float64, b: wp.float64,
               i_lo: int, i_hi: int, row0: int, scheme: int):
-    """out = a*v0 + b*(v + dt*(-div(v u) + div(2 nu S)_y - dp/dy)) on v-faces of one row."""
+    """out = a*v0 + b*(v + dt*(-div(v u) + div(2 nu S)_y - dp/dy)) on v-faces of one row
+    (x-flux carried along the row, y-fluxes from ``yflux_v`` rows J-1 and J)."""
     J = row0 + wp.tid()
     half = wp.float64(0.5)
     one = wp.float64(1.0)
-    two = wp.float64(2.0)
     quarter = wp.float64(0.25)
     idx = one / dx
     ihf = one / hy_f[J]
-    ihct = one / hy_c[J]
-    ihcb = one / hy_c[J - 1]
     # weights of u rows J-1 and J at the corner height (face row J)
     wl = half * hy_c[J] * ihf
     wu = half * hy_c[J - 1] * ihf
-    rtm = hy_c[J] / hy_c[J - 1]
-    rtp = hy_c[J] / hy_c[J + 1]
-    rbm = hy_c[J - 1] / hy_c[J - 2]
-    rbp = hy_c[J - 1] / hy_c[J]
     I = i_lo
     ucl = wl * u[J - 1, I] + wu * u[J, I]
     nul = quarter * (nu[J - 1, I - 1] + nu[J - 1, I] + nu[J, I - 1] + nu[J, I])
@@ -147,13 +163,7 @@ def predict_v(u: wp.array2d(dtype=wp.float64), v: wp.array2d(dtype=wp.float64),
         nur = quarter * (nu[J - 1, I] + nu[J - 1, I + 1] + nu[J, I] + nu[J, I + 1])
         fr = upwind_flux(ucr, v[J, I - 1], v[J, I], v[J, I + 1], v[J, I + 2], one, one, half, scheme) \
             - nur * ((v[J, I + 1] - v[J, I]) * idx + (u[J, I + 1] - u[J - 1, I + 1]) * ihf)
-        vt = half * (v[J, I] + v[J + 1, I])
-        gt = upwind_flux(vt, v[J - 1, I], v[J, I], v[J + 1, I], v[J + 2, I], rtm, rtp, half, scheme) \
-            - two * nu[J, I] * (v[J + 1, I] - v[J, I]) * ihct
-        vb = half * (v[J - 1, I] + v[J, I])
-        gb = upwind_flux(vb, v[J - 2, I], v[J - 1, I], v[J, I], v[J + 1, I], rbm, rbp, half, scheme) \
-            - two * nu[J - 1, I] * (v[J, I] - v[J - 1, I]) * ihcb
-        rhs = -(fr - fl) * idx - (gt - gb) * ihf - (p[J, I] - p[J - 1, I]) * ihf
+        rhs = -(fr - fl) * idx - (gflux[J, I] - gflux[J - 1, I]) * ihf - (p[J, I] - p[J - 1, I]) * ihf
         out[J, I] = a * v0[J, I] + b * (v[J, I] + dt * rhs)
         fl = fr
 

@@ -34,8 +34,10 @@ from kernels import cfd as kc  # noqa: E402
 
 # Bytes moved per cell per STAGE, assuming each array is streamed once (stencil neighbours in cache):
 BYTES_PER_CELL_STAGE = {
-    "predict_u": 6 * 8,   # read u, v, p, nu, u0; write u*
-    "predict_v": 6 * 8,
+    "yflux_u": 4 * 8,     # read u, v, nu; write the corner fluxes
+    "predict_u": 6 * 8,   # read u, p, nu, u0, fluxes; write u*
+    "yflux_v": 3 * 8,     # read v, nu; write the centre fluxes
+    "predict_v": 7 * 8,   # read u, v, p, nu, v0, fluxes; write v*
     "divergence": 3 * 8,  # read u*, v*; write rhs
     "poisson": 6 * 16,    # forward + inverse DCT along two axes, ~3 read+write passes each, + scaling
     "project": 7 * 8,     # read u*, v*, phi, p; write u, v, p
@@ -81,12 +83,17 @@ def bench_warp(nx, ny, threads, repeats, steps, device=None):
     g = GHOST
     L = sim.L
     parts = {
+        "yflux_u": lambda: L.rows(kc.yflux_u, ny + 1, g, [sim.u, sim.v, sim.nu, sim.hy_c, sim.hy_f, sim.grid.dx,
+                                                         g + 1, g + nx, ROW0, sim.scheme, sim._flux_u]),
         "predict_u": lambda: L.rows(kc.predict_u, ny, g, [sim.u, sim.v, sim._p_zero, sim.nu, sim.u, sim.u_star,
-                                                          sim.hy_c, sim.hy_f, sim.grid.dx, dt, 0.5, 0.5,
+                                                          sim.hy_c, sim._flux_u, sim.grid.dx, dt, 0.5, 0.5,
                                                           g + 1, g + nx, ROW0, sim.scheme]),
+        "yflux_v": lambda: L.rows(kc.yflux_v, ny, g, [sim.v, sim.nu, sim.hy_c, g, g + nx, ROW0, sim.scheme,
+                                                      sim._flux_v]),
         "predict_v": lambda: L.rows(kc.predict_v, ny - 1, g + 1, [sim.u, sim.v, sim._p_zero, sim.nu, sim.v,
-                                                                  sim.v_star, sim.hy_c, sim.hy_f, sim.grid.dx,
-                                                                  dt, 0.5, 0.5, g, g + nx, ROW0, sim.scheme]),
+                                                                  sim.v_star, sim.hy_c, sim.hy_f, sim._flux_v,
+                                                                  sim.grid.dx, dt, 0.5, 0.5, g, g + nx, ROW0,
+                                                                  sim.scheme]),
         "boundaries": lambda: sim.bc.set_normal_faces(sim.u, sim.u, sim.u_star, sim.t, dt, 0.5, 0.5),
         "divergence": lambda: L.rows(kc.divergence, ny, 0, [sim.u_star, sim.v_star, sim.hy_c, sim.grid.dx,
                                                             1.0, g, nx, ROW0, sim.rhs]),
@@ -171,7 +178,7 @@ def main(argv=None):
         print(f"  full step (2 stages)   {w['step'] / 1e6:8.2f} M cell-steps/s   "
               f"NumPy same step {npy / 1e6:6.3f}  -> speed-up {w['step'] / npy:5.1f}x   "
               f"roofline {roof / 1e6:6.1f} -> {w['step'] / roof:5.1%}")
-        for name in ("predict_u", "predict_v", "boundaries", "divergence", "poisson", "project", "ghosts"):
+        for name in ("yflux_u", "predict_u", "yflux_v", "predict_v", "boundaries", "divergence", "poisson", "project", "ghosts"):
             print(f"  {name:<22} {w[name] / 1e6:8.1f} M cells/s per call  ({1e9 / w[name]:6.2f} ns/cell)")
     if args.json:
         Path(args.json).parent.mkdir(parents=True, exist_ok=True)

@@ -107,6 +107,7 @@ class Simulation:
         self.u, self.v, self.p = z(ushape), z(vshape), z(pshape)
         self.u_stage, self.v_stage = z(ushape), z(vshape)
         self.u_star, self.v_star = z(ushape), z(vshape)
+        self._flux_u, self._flux_v = z((ny + 1 + 2 * g, nx + 1 + 2 * g)), z(pshape)  # shared y-fluxes
         self._p_zero = z(pshape) if config.pressure == "full" else None
         self.nu = wp.full(pshape, config.nu, dtype=WP_DTYPE, device=dev)
         self.rhs, self.phi = z((ny, nx)), z((ny, nx))
@@ -170,13 +171,19 @@ class Simulation:
         return float(min(dt_visc, dt_conv, c.dt_max))
 
     def _predict(self, src_u, src_v, u0, v0, dt, a, b):
+        """Predicted u*, v* (interior faces) from the stage input (src) and the step start (u0, v0)."""
         g, nx, ny = GHOST, self.grid.nx, self.grid.ny
         dx, s = self.grid.dx, self.scheme
         p = self.p if self.config.pressure == "incremental" else self._p_zero
-        self.L.rows(_k.predict_u, ny, g, [src_u, src_v, p, self.nu, u0, self.u_star, self.hy_c,
-                                          self.hy_f, dx, dt, a, b, g + 1, g + nx, ROW0, s])
+        gu, gv = self._flux_u, self._flux_v
+        # y-fluxes once per corner / centre row, shared by the two faces they separate
+        self.L.rows(_k.yflux_u, ny + 1, g, [src_u, src_v, self.nu, self.hy_c, self.hy_f, dx, g + 1, g + nx,
+                                            ROW0, s, gu])
+        self.L.rows(_k.predict_u, ny, g, [src_u, src_v, p, self.nu, u0, self.u_star, self.hy_c, gu,
+                                          dx, dt, a, b, g + 1, g + nx, ROW0, s])
+        self.L.rows(_k.yflux_v, ny, g, [src_v, self.nu, self.hy_c, g, g + nx, ROW0, s, gv])
         self.L.rows(_k.predict_v, ny - 1, g + 1, [src_u, src_v, p, self.nu, v0, self.v_star, self.hy_c,
-                                                  self.hy_f, dx, dt, a, b, g, g + nx, ROW0, s])
+                                                  self.hy_f, gv, dx, dt, a, b, g, g + nx, ROW0, s])
 
     def _project(self, dst_u, dst_v, c):
         g, nx, ny = GHOST, self.grid.nx, self.grid.ny
