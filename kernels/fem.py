@@ -19,7 +19,7 @@ Beam (kind 0): Hermite cubic bending, linear axial/torsion; consistent mass with
 (Przemieniecki 1968, ch. 11; Cook et al., Concepts and Applications of FEA, 4th ed., 16.3) and the
 consistent geometric stiffness of an axial force N (Przemieniecki; Cook 18.4) in both bending planes.
 No Wagner (torsional) term in the geometric stiffness.
-Cable (kind 2-node truss): EA/L axially, string geometric stiffness N/L on both transverse
+Cable (kind 1, 2-node truss): EA/L axially, string geometric stiffness N/L on both transverse
 translations (linear shape functions), consistent linear translational mass, nothing on rotations:
 a cable with N = 0 has exactly zero transverse stiffness.
 """
