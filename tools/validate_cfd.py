@@ -106,8 +106,9 @@ def cylinder(re, ppd, t_end, window, threads, scheme):
     return out
 
 
-def _line_pressure(sim, x_target, side, y_line, body_phi):
-    """Pressure at (x_target, y_line) extrapolated from the two nearest fluid cells on one side."""
+def _line_pressure(sim, x_target, side, y_line, body_phi, min_gap=0.5):
+    """Pressure at (x_target, y_line) extrapolated linearly from the two nearest cells on one side
+    that lie at least ``min_gap`` cells outside the body."""
     g = sim.grid
     _, _, p = sim.interior()
     yc = g.y_centres
@@ -115,7 +116,7 @@ def _line_pressure(sim, x_target, side, y_line, body_phi):
     w = (y_line - yc[j - 1]) / (yc[j] - yc[j - 1])
     line = (1 - w) * p[j - 1] + w * p[j]
     xc = g.x_centres
-    fluid = body_phi(xc, y_line) > 0.5 * g.dx
+    fluid = body_phi(xc, y_line) > min_gap * g.dx
     idx = np.nonzero(fluid & ((xc < x_target) if side < 0 else (xc > x_target)))[0]
     k = idx[-2:] if side < 0 else idx[:2]
     x1, x2 = xc[k]
@@ -152,9 +153,11 @@ def dfg(ppd, t_end, threads, scheme):
         return np.hypot(x - 0.2, y - 0.2) - d / 2
 
     dp = _line_pressure(sim, 0.15, -1, 0.2, phi) - _line_pressure(sim, 0.25, +1, 0.2, phi)
+    # the same from cells >= 1.5 h off the wall (the first fluid faces carry the direct forcing)
+    dp_far = _line_pressure(sim, 0.15, -1, 0.2, phi, 1.5) - _line_pressure(sim, 0.25, +1, 0.2, phi, 1.5)
     return {"case": "DFG 2D-1", "ppd": ppd, "cells": nx * ny, "nx": nx, "ny": ny, "t_end": float(sim.t),
             "steps": sim.n_steps, "wall_s": wall, "blockage": d / h_ch, "advection": scheme,
-            "c_D": float(scale * f[-1, 0, 0]), "c_L": float(scale * f[-1, 0, 1]), "dp": dp,
+            "c_D": float(scale * f[-1, 0, 0]), "c_L": float(scale * f[-1, 0, 1]), "dp": dp, "dp_far": dp_far,
             "c_D_drift_per_time": float(np.polyfit(t[last], scale * f[last, 0, 0], 1)[0]),
             "band": BANDS["dfg"]}
 
