@@ -158,10 +158,11 @@ def main(argv=None):
     ap.add_argument("--numpy-steps", type=int, default=2)
     ap.add_argument("--device", default=None)
     ap.add_argument("--json", default=None)
+    ap.add_argument("--bandwidth-mb", type=int, default=256, help="array size of the bandwidth test")
     args = ap.parse_args(argv)
     wp.config.quiet = True
     wp.init()
-    copy_bw, triad_bw = bandwidth()
+    copy_bw, triad_bw = bandwidth(args.bandwidth_mb * 2**20)
     bytes_step = 2 * sum(BYTES_PER_CELL_STAGE.values())
     bw = triad_bw * 1e9
     print(f"memory bandwidth: memcpy {copy_bw:.1f} GB/s, 2-thread triad {triad_bw:.1f} GB/s; "
