@@ -97,3 +97,32 @@ def test_beam_geometric_stiffness_under_tension():
     exact = np.sqrt((k**4 * EI + k**2 * tension) / M_LEN) / (2 * np.pi)
     assert np.allclose(f, exact, rtol=1e-4)
     assert not np.allclose(f, np.sqrt(k**4 * EI / M_LEN) / (2 * np.pi), rtol=1e-2)  # tension matters here
+
+
+@pytest.mark.parametrize("lambda2", [10.0, 40.0, 150.0])
+def test_irvine_caughey_sagging_cable(lambda2):
+    """First symmetric in-plane mode of a shallow sagging cable (Irvine & Caughey 1974; VALIDATION.md):
+    tan(w/2) = w/2 - (4/lambda^2)(w/2)^3, w = omega L sqrt(m/H), lambda^2 = (m g L/H)^2 L/(H L_e/EA).
+    Checks the elastic (EA) and geometric (H) stiffness of the cable elements working together; the
+    antisymmetric mode (w = 2 pi) does not stretch the cable and is independent of lambda^2."""
+    from scipy.optimize import brentq
+
+    from bridge.structure.elements import ElementSet
+
+    span, mass, sag, g, n = 200.0, 100.0, 4.0, 9.81, 64
+    H = mass * g * span**2 / (8 * sag)
+    length_e = span * (1 + 8 * (sag / span) ** 2)
+    ea = lambda2 / (8 * sag / span) ** 2 * H * length_e / span
+    x = np.linspace(0.0, span, n + 1)
+    y = -4 * sag * x * (span - x) / span**2
+    nodes = np.stack([np.zeros_like(x), y, x], axis=1)
+    slope = np.diff(y) / np.diff(x)
+    props = np.array([props_row(ea=ea, mass=mass, axial=H * np.sqrt(1 + s * s), kind=KIND_CABLE) for s in slope])
+    es = ElementSet(nodes[:-1].copy(), nodes[1:].copy(), np.tile([1.0, 0.0, 0.0], (n, 1)), props)
+    conn = np.stack([np.arange(n), np.arange(1, n + 1)], axis=1)
+    f = frequencies(nodes, conn, es, node_dofs([0, n], (0, 1, 2)), node_dofs(range(n + 1), (1, 2)), n_modes=2)
+    scale = np.sqrt(H / mass) / span / (2 * np.pi)
+    root = brentq(lambda w: np.tan(w / 2) - w / 2 + 4 / lambda2 * (w / 2) ** 3, 1.0001 * np.pi, 2.9999 * np.pi)
+    f_sym, f_anti = root * scale, 2 * np.pi * scale
+    assert min(abs(f / f_sym - 1.0)) < 5e-3
+    assert min(abs(f / f_anti - 1.0)) < 5e-3
