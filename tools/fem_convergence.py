@@ -9,7 +9,7 @@ bridge.structure.analysis must be at least that).  Prints a Markdown table (docs
 
 ``--sensitivity`` adds the support variants discussed in docs/structure.md (same mesh): pylon tops
 (cable saddles) held longitudinally, girder free longitudinally at one end, girder free vertically
-at the pylons.  These are diagnostics of which assumption moves which frequency, not model options.
+at the pylons, pylon legs turned by 90 degrees, pylon concrete twice as stiff.  These are diagnostics of which assumption moves which frequency, not model options.
 """
 
 from __future__ import annotations
@@ -74,6 +74,17 @@ def sensitivity(name: str, n_sub: int = 4) -> list[tuple[str, dict]]:
         "girder free vertically at the pylons": dataclasses.replace(
             m, fixed=tuple(f for f in m.fixed if not (f[0] in at_pylons and f[1] == 1))),
     }
+    from bridge.config import BoxSection
+
+    p = s.pylon
+    rotated = dataclasses.replace(s, pylon=dataclasses.replace(
+        p, lower_leg=BoxSection(p.lower_leg.b_m, p.lower_leg.a_m, p.lower_leg.t_m),
+        upper_leg=BoxSection(p.upper_leg.b_m, p.upper_leg.a_m, p.upper_leg.t_m)))
+    conc = s.materials[p.material]
+    stiffer = dataclasses.replace(s, materials={**s.materials, p.material: dataclasses.replace(
+        conc, youngs_modulus_Pa=2.0 * conc.youngs_modulus_Pa)})
+    variants["pylon legs turned 90 degrees (side b along the bridge)"] = build_model(rotated, c, n_sub)
+    variants["pylon concrete E x 2"] = build_model(stiffer, c, n_sub)
     out = []
     for label, mod in variants.items():
         a = assemble(mod)
