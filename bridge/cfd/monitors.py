@@ -110,7 +110,7 @@ def run(sim: Simulation, t_end: float, monitors=(), max_steps: int | None = None
         dt = sim.stable_dt()
         if land_exactly:
             dt = min(dt, t_end - sim.t)
-        sim.last_dt = sim.step(dt)
+        sim.step(dt)
         n += 1
         for m in monitors:
             m(sim)

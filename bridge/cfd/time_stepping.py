@@ -122,6 +122,15 @@ class Simulation:
         self.nu_max = config.nu
         self.last_dt = 0.0
 
+    def add_body(self, polygon, motion, margin: int = 3):
+        """Immerse a rigid polygon moving with ``motion``; returns the ``ImmersedBody``."""
+        from .immersed import ImmersedBody
+
+        body = ImmersedBody(polygon, motion, self.grid, self.L, margin)
+        self.bodies.append(body)
+        self.last_force.append(np.zeros(3))
+        return body
+
     # --- initialisation ---------------------------------------------------------------------------
     def set_state(self, u=None, v=None, p=None, t: float = 0.0):
         """Set the interior/boundary faces from (ny, nx+1), (ny+1, nx), (ny, nx) arrays or scalars."""
@@ -219,6 +228,7 @@ class Simulation:
             src_u, src_v = dst_u, dst_v
         weights = [float(np.prod([bb for _, bb in self.stages[k + 1:]])) for k in range(n)]
         self.last_force = [body.force(weights, dt, self.t, t_new, self.config.rho) for body in self.bodies]
+        self.last_dt = dt
         self.t = t_new
         self.n_steps += 1
         return dt

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from bridge.cfd import (CartesianGrid, FlowConfig, FlowDiverged, ForceHistory, HarmonicMotion,
-                        ImmersedBody, NaNMonitor, Simulation, Stationary, UniformTranslation, circle,
+                        NaNMonitor, Simulation, Stationary, UniformTranslation, circle,
                         run)
 
 from helpers import SLIP_BOX
@@ -14,7 +14,7 @@ from helpers import SLIP_BOX
 def _channel(motion, nu=0.05, n=16):
     grid = CartesianGrid.uniform(8 * n, 4 * n, (0.0, 8.0), (-2.0, 2.0))
     sim = Simulation(grid, FlowConfig(nu=nu, cfl=0.4))
-    sim.bodies = [ImmersedBody(circle(1.0), motion, grid, sim.L)]
+    sim.add_body(circle(1.0), motion)
     sim.set_state(u=1.0)
     return sim
 
@@ -50,7 +50,7 @@ def _added_mass_coefficient(n):
     grid = CartesianGrid.uniform(8 * n, 8 * n, (-4.0, 4.0), (-4.0, 4.0))
     amp, omega, nu = 0.05, 2 * np.pi, 1e-3
     sim = Simulation(grid, FlowConfig(nu=nu, bc=SLIP_BOX))
-    sim.bodies = [ImmersedBody(circle(1.0), HarmonicMotion(0.0, 0.0, (amp, 0.0, 0.0), omega), grid, sim.L)]
+    sim.add_body(circle(1.0), HarmonicMotion(0.0, 0.0, (amp, 0.0, 0.0), omega))
     sim.set_state(u=0.0, v=0.0)
     h = ForceHistory()
     dt = 1.0 / 200
