@@ -311,7 +311,7 @@ def polygon_signed_distance(px: wp.float64, py: wp.float64, verts: wp.array(dtyp
     """Signed distance from (px, py) to a closed polygon (negative inside; even-odd rule)."""
     n = verts.shape[0]
     dmin = wp.float64(1.0e300)
-    inside = int(0)
+    inside = int(0)  # noqa: UP018 (Warp: a dynamic variable, mutated in the loop)
     for k in range(n):
         a = verts[k]
         b = verts[(k + 1) % n]
@@ -378,7 +378,7 @@ def ib_targets(q: wp.array2d(dtype=wp.float64), phi: wp.array2d(dtype=wp.float64
     J = j0 + jb
     for ib in range(ni):
         I = i0 + ib
-        st = int(0)
+        st = int(0)  # noqa: UP018 (Warp: a dynamic variable, mutated in the loop)
         tg = wp.float64(0.0)
         if ib > 0 and ib < ni - 1 and jb > 0 and jb < phi.shape[0] - 1 and I >= ilo and I < ihi \
                 and J >= jlo and J < jhi:
@@ -392,8 +392,8 @@ def ib_targets(q: wp.array2d(dtype=wp.float64), phi: wp.array2d(dtype=wp.float64
                 acc = wp.float64(0.0)
                 cnt = wp.float64(0.0)
                 for k in range(4):
-                    di = int(0)
-                    dj = int(0)
+                    di = int(0)  # noqa: UP018 (Warp dynamic variable)
+                    dj = int(0)  # noqa: UP018 (Warp dynamic variable)
                     h = wp.float64(dx)
                     if k == 0:
                         di = -1

@@ -38,6 +38,7 @@ BYTES_PER_CELL_STAGE = {
     "predict_u": 6 * 8,   # read u, p, nu, u0, fluxes; write u*
     "yflux_v": 3 * 8,     # read v, nu; write the centre fluxes
     "predict_v": 7 * 8,   # read u, v, p, nu, v0, fluxes; write v*
+    "boundaries": 0,      # O(ny) per call
     "divergence": 3 * 8,  # read u*, v*; write rhs
     "poisson": 6 * 16,    # forward + inverse DCT along two axes, ~3 read+write passes each, + scaling
     "project": 7 * 8,     # read u*, v*, phi, p; write u, v, p
@@ -150,7 +151,8 @@ def bandwidth(n_bytes=256 * 2**20, repeats=5):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap = argparse.ArgumentParser(description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--sizes", default="256x128,512x256,1024x512")
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--repeats", type=int, default=5)
@@ -179,7 +181,8 @@ def main(argv=None):
         print(f"  full step (2 stages)   {w['step'] / 1e6:8.2f} M cell-steps/s   "
               f"NumPy same step {npy / 1e6:6.3f}  -> speed-up {w['step'] / npy:5.1f}x   "
               f"roofline {roof / 1e6:6.1f} -> {w['step'] / roof:5.1%}")
-        for name in ("yflux_u", "predict_u", "yflux_v", "predict_v", "boundaries", "divergence", "poisson", "project", "ghosts"):
+        for name in ("yflux_u", "predict_u", "yflux_v", "predict_v", "boundaries", "divergence", "poisson",
+                     "project", "ghosts"):
             print(f"  {name:<22} {w[name] / 1e6:8.1f} M cells/s per call  ({1e9 / w[name]:6.2f} ns/cell)")
     if args.json:
         Path(args.json).parent.mkdir(parents=True, exist_ok=True)

@@ -29,8 +29,19 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import warp as wp  # noqa: E402
 
-from bridge.cfd import (BoundaryConditions, CartesianGrid, FlowConfig, ForceHistory, ImmersedBody,  # noqa: E402
-                        NaNMonitor, Simulation, Stationary, circle, run, stretched_faces)
+from bridge.cfd import (  # noqa: E402
+    BoundaryConditions,
+    CartesianGrid,
+    FlowConfig,
+    ForceHistory,
+    ImmersedBody,
+    NaNMonitor,
+    Simulation,
+    Stationary,
+    circle,
+    run,
+    stretched_faces,
+)
 
 BANDS = {  # VALIDATION.md
     20: {"C_D": (2.00, 2.09), "L_w/D": (0.91, 0.94)},
@@ -93,7 +104,7 @@ def cylinder(re, ppd, t_end, window, threads, scheme):
     if re < 50:
         last = t > t[-1] - 5
         out["C_D"] = float(cd[-1])
-        out["C_D_drift_per_time"] = float(np.polyfit(t[last], cd[last], 1)[0])
+        out["C_D_drift_per_time"] = float(np.polyfit(t[last] - t[-1], cd[last], 1)[0]) if last.sum() > 2 else np.nan
         out["L_w/D"] = _wake_length(sim, 0.5, 0.0)
     else:
         st, span = _strouhal(t, cl, window)
@@ -158,7 +169,8 @@ def dfg(ppd, t_end, threads, scheme):
     return {"case": "DFG 2D-1", "ppd": ppd, "cells": nx * ny, "nx": nx, "ny": ny, "t_end": float(sim.t),
             "steps": sim.n_steps, "wall_s": wall, "blockage": d / h_ch, "advection": scheme,
             "c_D": float(scale * f[-1, 0, 0]), "c_L": float(scale * f[-1, 0, 1]), "dp": dp, "dp_far": dp_far,
-            "c_D_drift_per_time": float(np.polyfit(t[last], scale * f[last, 0, 0], 1)[0]),
+            "c_D_drift_per_time": float(np.polyfit(t[last] - t[-1], scale * f[last, 0, 0], 1)[0])
+            if last.sum() > 2 else np.nan,
             "band": BANDS["dfg"]}
 
 

@@ -10,8 +10,8 @@ advection stencil reaches two points upstream).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 import warp as wp

@@ -8,8 +8,9 @@ counter-clockwise) and its velocity (u, v, omega). Later issues drive these from
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable, Protocol
+from typing import Protocol
 
 __all__ = ["RigidMotion", "Stationary", "UniformTranslation", "HarmonicMotion", "PrescribedMotion"]
 
@@ -100,4 +101,4 @@ class PrescribedMotion:
         if self.velocity_fn is not None:
             return tuple(float(q) for q in self.velocity_fn(t))
         a, b = self.pose_fn(t - self.dt_fd), self.pose_fn(t + self.dt_fd)
-        return tuple((qb - qa) / (2 * self.dt_fd) for qa, qb in zip(a, b))
+        return tuple((qb - qa) / (2 * self.dt_fd) for qa, qb in zip(a, b, strict=True))

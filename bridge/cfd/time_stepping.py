@@ -29,7 +29,7 @@ from .advection import scheme_code
 from .boundaries import BoundaryConditions, BoundaryOperator
 from .grids import GHOST, CartesianGrid
 from .launch import ROW0, RowLauncher
-from .precision import DTYPE, WP_DTYPE
+from .precision import WP_DTYPE
 from .pressure import PoissonSolver
 
 __all__ = ["FlowConfig", "Simulation", "TIME_SCHEMES", "FlowDiverged"]
@@ -174,7 +174,8 @@ class Simulation:
             return c.dt
         ui, vi, _ = self.interior()
         h = self.grid.min_spacing
-        rate = np.abs(ui).max() / self.grid.dx + (np.abs(vi[1:-1]) / self.grid.hy_faces()[GHOST + 1:GHOST + self.grid.ny][:, None]).max()
+        hf = self.grid.hy_faces()[GHOST + 1:GHOST + self.grid.ny][:, None]
+        rate = np.abs(ui).max() / self.grid.dx + (np.abs(vi[1:-1]) / hf).max()
         dt_visc = c.fourier * h * h / self.nu_max
         dt_conv = c.cfl / rate if rate > 0 else np.inf
         return float(min(dt_visc, dt_conv, c.dt_max))

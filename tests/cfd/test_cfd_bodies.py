@@ -3,12 +3,21 @@ symmetric drag, an accelerating body feels the added mass of potential theory (V
 
 import numpy as np
 import pytest
-
-from bridge.cfd import (CartesianGrid, FlowConfig, FlowDiverged, ForceHistory, HarmonicMotion,
-                        NaNMonitor, Simulation, Stationary, UniformTranslation, circle,
-                        run)
-
 from helpers import SLIP_BOX
+
+from bridge.cfd import (
+    CartesianGrid,
+    FlowConfig,
+    FlowDiverged,
+    ForceHistory,
+    HarmonicMotion,
+    NaNMonitor,
+    Simulation,
+    Stationary,
+    UniformTranslation,
+    circle,
+    run,
+)
 
 
 def _channel(motion, nu=0.05, n=16):

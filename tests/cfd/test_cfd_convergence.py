@@ -2,10 +2,9 @@
 
 import numpy as np
 import pytest
+from helpers import advance, loglog_slope, taylor_green, taylor_green_exact
 
 from bridge.cfd.advection import SCHEMES
-
-from helpers import advance, loglog_slope, taylor_green, taylor_green_exact
 
 NU = 0.01  # viscous limit stays far below the CFL step on all three grids
 

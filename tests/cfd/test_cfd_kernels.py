@@ -4,15 +4,13 @@ Poisson solver identity, signed distance to polygons. Run on cpu and (marker cud
 import numpy as np
 import pytest
 import warp as wp
+from conftest import DEVICES
 
-from bridge.cfd import (CartesianGrid, FlowConfig, PoissonSolver, Simulation, circle, max_divergence,
-                        stretched_faces)
+from bridge.cfd import CartesianGrid, FlowConfig, PoissonSolver, Simulation, circle, max_divergence, stretched_faces
 from bridge.cfd.advection import SCHEMES
 from bridge.cfd.precision import DTYPE, WP_DTYPE
 from bridge.cfd.reference_numpy import NumpyFlow
 from kernels import cfd as kc
-
-from conftest import DEVICES
 
 GRIDS = {
     "uniform": lambda: CartesianGrid(np.linspace(0, 4, 41), np.linspace(-1, 1, 25)),
