@@ -152,20 +152,29 @@ def classify_modes(scenario: Scenario, frequencies_hz: np.ndarray, shapes_full: 
         counters[k, s] = counters.get((k, s), 0) + 1
         labels.append(f"{s}-{_KIND_LETTER[k]}{counters[k, s]}")
     modal_masses = np.einsum("di,di->i", shapes, mass_full @ shapes)
-    # damping by symmetry rank among vertical and torsional modes (Table 3.4)
-    rows = {s: [d.ratio for d in scenario.damping if d.symmetry == s] for s in ("S", "SS")}
-    rank = {"S": 0, "SS": 0}
-    damping = np.zeros(n)
-    for i, (k, s) in enumerate(zip(kinds, syms)):
-        table = rows[s] or [0.0]
-        if k in ("vertical", "torsional"):
-            damping[i] = table[min(rank[s], len(table) - 1)]
-            rank[s] += 1
-        else:
-            damping[i] = table[-1]
+    damping = assign_damping(scenario.damping, frequencies_hz, syms)
     return ModeSet(
         frequencies_hz=np.asarray(frequencies_hz, dtype=np.float64), kinds=tuple(kinds), symmetries=tuple(syms),
         labels=tuple(labels), energy_shares=shares, deck_share=deck_share, modal_masses=modal_masses,
         damping_ratios=damping, z_m=z.copy(), U=shapes[dof + 1].T.copy(), Theta=shapes[dof + 5].T.copy(),
         V=shapes[dof + 0].T.copy(), W=shapes[dof + 2].T.copy(), shapes=shapes, deck_length_m=deck_length_m,
         mid_span_z_m=mid_span_z_m)
+
+
+def assign_damping(table, frequencies_hz, symmetries) -> np.ndarray:
+    """Damping ratio of each model mode from thesis Table 3.4 (``scenario.damping`` rows).
+
+    Rule: a mode takes the ratio of the measured mode of the same symmetry (S / SS) whose frequency is
+    nearest to its own.  Table 3.4 gives symmetry but not mode type, and the model has modes the
+    measurement did not identify (lateral, cable), so matching by index or by rank would hand e.g. the
+    first symmetric torsional mode (0.278 Hz here) the ratio of a measured mode at 0.429 Hz; by frequency it
+    gets that of the 0.287 Hz mode it most likely is.  The up-scaled models use the same table (thesis 1.5),
+    matched by their own frequencies.
+    """
+    out = np.zeros(len(frequencies_hz))
+    for i, (f, s) in enumerate(zip(frequencies_hz, symmetries, strict=True)):
+        rows = [d for d in table if d.symmetry == s] or list(table)
+        if not rows:
+            continue
+        out[i] = min(rows, key=lambda d: abs(d.frequency_hz - f)).ratio
+    return out
