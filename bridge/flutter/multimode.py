@@ -53,6 +53,8 @@ class MultimodeResult:
     max_speed_searched_m_s: float
     divergence_speed_m_s: float = np.nan   # lowest V (up to the flutter speed's interval) where a mode's
                                            # frequency went to zero (static divergence), or NaN
+    unresolved: tuple[tuple[str, float], ...] = ()  # (mode, V) where the p-k iteration found no root on the
+                                                    # tracked branch (branch jumps); NaN there, listed in reports
 
 
 def _state_matrix(model: ModalModel, aero: AerodynamicModel, rho: float, w: float, V: float) -> np.ndarray:
@@ -71,7 +73,8 @@ def _state_matrix(model: ModalModel, aero: AerodynamicModel, rho: float, w: floa
 
 def aeroelastic_eigenvalues(model: ModalModel, aero: AerodynamicModel, air_density: float, speed: float,
                             guesses: np.ndarray, shapes: np.ndarray | None = None, tolerance: float = 1e-10,
-                            max_iterations: int = 200) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                            max_iterations: int = 200, strict: bool = True
+                            ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """p-k eigenvalue s_r and modal shape (complex N-vector of modal amplitudes) of each mode at wind
     speed V, iterating on frequency from ``guesses`` (one per mode: the previous speed's eigenvalues, or
     i w_r at the first speed).
@@ -84,7 +87,9 @@ def aeroelastic_eigenvalues(model: ModalModel, aero: AerodynamicModel, air_densi
 
     The trial frequency is kept inside the aerodynamic model's Omega range (a table is never
     extrapolated); the third return value flags the modes whose iteration wanted to leave it (their
-    eigenvalue is then not a p-k solution and the caller discards it).
+    eigenvalue is then not a p-k solution and the caller discards it).  With ``strict=False`` a mode whose
+    iteration does not converge (the tracked eigenvalue jumps between branches, so Im s(w) = w has no
+    root on it) is flagged the same way instead of raising ConvergenceError.
     """
     n = model.n_modes
     shapes = np.eye(n, dtype=np.complex128) if shapes is None else np.asarray(shapes, dtype=np.complex128)
@@ -94,32 +99,54 @@ def aeroelastic_eigenvalues(model: ModalModel, aero: AerodynamicModel, air_densi
     w_lo = max(w_floor, o_lo * speed / model.deck_width_m)      # Omega range of the model, as w at this V
     w_hi = o_hi * speed / model.deck_width_m
     outside = np.zeros(n, dtype=bool)
+    unresolved = np.zeros(n, dtype=bool)
     scale = np.sqrt(model.modal_masses)[:, None]   # shapes compared in mass-normalised coordinates
     for r, s_prev in enumerate(np.asarray(guesses, dtype=np.complex128)):
         ref = shapes[:, r] / np.linalg.norm(shapes[:, r])
-        s = s_prev
-        w = min(max(abs(s.imag), w_lo), w_hi)
-        for _ in range(max_iterations):
+
+        def track(w: float, ref=ref, s_prev=s_prev) -> tuple[complex, np.ndarray, float]:
+            """Eigenvalue of this mode at trial frequency w, and g(w) = Im s - w (clipped to the range)."""
             lam, vec = np.linalg.eig(_state_matrix(model, aero, air_density, w, speed))
             keep = lam.imag >= 0.0
-            lam, X = lam[keep], vec[:n, keep]
-            X = scale * X
+            lam, X = lam[keep], scale * vec[:n, keep]
             X = X / np.linalg.norm(X, axis=0)
             mac = np.abs(ref.conj() @ X) ** 2
             score = mac - 1e-6 * np.abs(lam - s_prev) / max(abs(s_prev), w_floor)
             i = int(np.argmax(score))
-            s, phi = lam[i], X[:, i]
-            w_new = min(max(s.imag, w_lo), w_hi)
-            change = abs(w_new - w) / w
-            if change <= tolerance:
-                break
-            w = w_new
-        else:
-            raise ConvergenceError(f"p-k frequency iteration, mode {model.labels[r]} at V = {speed:g} m/s",
-                                   max_iterations, change, tolerance)
+            return lam[i], X[:, i], min(max(lam[i].imag, w_lo), w_hi) - w
+
+        # p-k condition Im s(w) = w: secant iteration on g(w), which converges where the plain fixed point
+        # w <- Im s(w) crawls or oscillates; a step that leaves the range falls back to a damped fixed point.
+        w_a = min(max(abs(s_prev.imag), w_lo), w_hi)
+        s, phi, g_a = track(w_a)
+        w_b = w_a + g_a
+        change = abs(g_a) / w_a
+        if change > tolerance:
+            for _ in range(max_iterations):
+                s, phi, g_b = track(w_b)
+                change = abs(g_b) / w_b
+                if change <= tolerance:
+                    break
+                w_c = w_b - g_b * (w_b - w_a) / (g_b - g_a) if g_b != g_a else w_b + g_b
+                if not (np.isfinite(w_c) and w_lo <= w_c <= w_hi and w_c > 0.0):
+                    w_c = w_b + 0.5 * g_b
+                w_a, g_a, w_b = w_b, g_b, w_c
+            else:
+                if strict:
+                    raise ConvergenceError(f"p-k frequency iteration, mode {model.labels[r]} at V = {speed:g} m/s",
+                                           max_iterations, change, tolerance)
+                unresolved[r] = True
         out[r], out_shapes[:, r] = s, phi
-        outside[r] = (s.imag < w_lo and w_lo > w_floor) or s.imag > w_hi
+        outside[r] = (s.imag < w_lo and w_lo > w_floor) or s.imag > w_hi or unresolved[r]
     return out, out_shapes, outside
+
+
+def _is_unresolved(model: ModalModel, aero: AerodynamicModel, V: float, s: complex) -> bool:
+    """True when a flagged mode's eigenvalue lies inside the aerodynamic model's range: it was flagged for
+    a failed iteration, not for leaving the range."""
+    o_lo, o_hi = aero.omega_range
+    omega = s.imag * model.deck_width_m / V
+    return o_lo <= omega <= o_hi
 
 
 def _damping(s: np.ndarray) -> np.ndarray:
@@ -147,13 +174,20 @@ def pk_sweep(model: ModalModel, aero: AerodynamicModel, air_density: float, max_
     eig = np.empty((speeds.size, model.n_modes), dtype=np.complex128)
     shapes = np.empty((speeds.size, model.n_modes, model.n_modes), dtype=np.complex128)
     outside = np.zeros((speeds.size, model.n_modes), dtype=bool)
+    unresolved = []
     for n, V in enumerate(speeds):
-        s, phi, off = aeroelastic_eigenvalues(model, aero, air_density, V, s, phi, tolerance)
-        eig[n], shapes[n], outside[n] = s, phi, off
+        s_new, phi_new, off = aeroelastic_eigenvalues(model, aero, air_density, V, s, phi, tolerance, strict=False)
+        in_range = (s_new.imag >= 0.0) & ~off
+        unresolved += [(model.labels[r], float(V)) for r in np.flatnonzero(off & (s_new.imag > 0.0))
+                       if _is_unresolved(model, aero, V, s_new[r])]
+        # a mode with no solution here keeps its last good eigenvalue and shape as the next start value
+        s = np.where(in_range, s_new, s)
+        phi = np.where(in_range[None, :], phi_new, phi)
+        eig[n], shapes[n], outside[n] = s_new, phi_new, off
     zeta = np.where(outside, np.nan, _damping(eig))        # NaN: outside the aerodynamic model's range
     freq = np.where(outside, np.nan, eig.imag / (2 * np.pi))
     result = dict(labels=model.labels, speed_m_s=speeds, frequency_hz=freq, damping_ratio=zeta,
-                  max_speed_searched_m_s=float(v_hi))
+                  max_speed_searched_m_s=float(v_hi), unresolved=tuple(unresolved))
     crossing = np.flatnonzero((zeta[:-1] > 0.0) & (zeta[1:] <= 0.0))  # flat index over (n_V-1, N)
     w_floor = 1e-3 * model.angular_frequencies.min()   # below this an unstable root is static: divergence
     divergence, flutter_at = np.nan, None

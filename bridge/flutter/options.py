@@ -12,7 +12,7 @@ Keys (all optional; defaults give a Theodorsen thin-plate analysis up to 150 m/s
     max_speed_m_s     highest mean wind speed searched (default 150)
     min_speed_m_s     lowest speed searched (default 1 % of max_speed_m_s, or the table's lowest V)
     speed_steps       points of the V scan (default 120; >= 10)
-    pairs             "thesis" (S-V1..3 with S-T1) | "all" (also SS-V1..3 with SS-T1)   (default "thesis")
+    pairs             "thesis" (S-V1..3 with S-T1) | "all" (also SS-V1..3 with SS-T1)   (default "all")
     multimode         run the p-k multimode sweep as well (default true)
 """
 
@@ -59,7 +59,7 @@ class FlutterOptions:
     max_speed_m_s: float = 150.0
     min_speed_m_s: float | None = None
     speed_steps: int = 120
-    pairs: str = "thesis"
+    pairs: str = "all"
     multimode: bool = True
 
     def __post_init__(self) -> None:

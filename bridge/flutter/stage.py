@@ -24,6 +24,7 @@ from bridge.flutter.determinant import FlutterResult, governing, solve_pair
 from bridge.flutter.modal import ModalModel
 from bridge.flutter.multimode import MultimodeResult, pk_sweep
 from bridge.flutter.options import FlutterOptions
+from bridge.results import write_dataset
 from bridge.stages import RunOptions, StageOutput
 
 __all__ = ["run", "FlutterStageResult"]
@@ -161,6 +162,11 @@ def _write_h5(group: Any, d: FlutterStageResult) -> None:
         g.attrs["reduced_frequency"] = mm.reduced_frequency
         g.attrs["unstable_mode"] = mm.unstable_mode
         g.attrs["divergence_speed_m_s"] = mm.divergence_speed_m_s
+        g.attrs["unresolved_points"] = len(mm.unresolved)
+        if mm.unresolved:
+            write_dataset(g, "unresolved_mode", [u[0] for u in mm.unresolved], "",
+                          "modes whose p-k iteration found no root on the tracked branch (NaN in the sweep)")
+            write_dataset(g, "unresolved_speed_m_s", [u[1] for u in mm.unresolved], "m/s", "speeds of those points")
 
 
 def _report(d: FlutterStageResult, source: str, fopts: FlutterOptions) -> str:
@@ -191,6 +197,11 @@ def _report(d: FlutterStageResult, source: str, fopts: FlutterOptions) -> str:
             else f"no damping ratio of an oscillating mode crosses zero below {m.max_speed_searched_m_s:g} m/s.")]
         if not math.isnan(m.divergence_speed_m_s):
             lines.append(f"Static divergence (frequency to zero) at V = {m.divergence_speed_m_s:.2f} m/s.")
+        if m.unresolved:
+            pts = ", ".join(f"{lab} at {v:.1f} m/s" for lab, v in m.unresolved[:8])
+            lines.append(f"p-k found no frequency root on the tracked branch at {len(m.unresolved)} point(s) "
+                         f"({pts}{', ...' if len(m.unresolved) > 8 else ''}): gaps (NaN) in the damping plot; "
+                         "the determinant method is unaffected.")
     return "\n".join(lines) + "\n"
 
 

@@ -21,7 +21,7 @@ SECTION = dict(mass_per_length_kg_m=20_000.0, inertia_per_length_kg_m2_m=20_000.
 
 def test_flutter_options_defaults_and_validation():
     o = FlutterOptions.from_mapping({}, "flutter")
-    assert o.aerodynamics == "theodorsen" and o.pairs == "thesis" and o.max_speed_m_s == 150.0
+    assert o.aerodynamics == "theodorsen" and o.pairs == "all" and o.max_speed_m_s == 150.0
     assert isinstance(o.aerodynamic_model(), Theodorsen)
     for bad, key in [({"aerodynamics": "cfd"}, "flutter.aerodynamics"),
                      ({"max_speed_m_s": -5}, "flutter.max_speed_m_s"),
