@@ -6,7 +6,7 @@
 
 Cylinder (diameter D = 1, U = 1): box x in [-10, 20] D (uniform in x), y in [-15, 15] D stretched
 outside |y| < 1.5 D (growth 5 %), uniform inflow, convective outflow, slip sides; blockage
-D/H = 1/30. Reported: C_D = 2 F_x/(rho U^2 D) (mean over whole shedding periods when unsteady),
+D/H = 1/30 (``--domain UPSTREAM DOWNSTREAM HALF_HEIGHT`` changes the box). Reported: C_D = 2 F_x/(rho U^2 D) (mean over whole shedding periods when unsteady),
 recirculation length L_w/D (last zero of u on the wake centreline, from the rear of the cylinder),
 Strouhal number from the zero up-crossings of C_L over the last ``--window`` time units.
 DFG 2D-1 (Schaefer and Turek 1996): channel 2.2 x 0.41, D = 0.1 at (0.2, 0.2), nu = 1e-3, parabolic
@@ -81,10 +81,11 @@ def _strouhal(t, cl, window):
     return float(1.0 / period), (tc[0], tc[-1])
 
 
-def cylinder(re, ppd, t_end, window, threads, scheme):
+def cylinder(re, ppd, t_end, window, threads, scheme, upstream=10.0, downstream=20.0, half_height=15.0):
     h = 1.0 / ppd
-    nx = int(round(30 / h))
-    grid = CartesianGrid(np.linspace(-10.0, 20.0, nx + 1), stretched_faces(-15.0, 15.0, (-1.5, 1.5), h, 1.05))
+    nx = int(round((upstream + downstream) / h))
+    grid = CartesianGrid(np.linspace(-upstream, downstream, nx + 1),
+                         stretched_faces(-half_height, half_height, (-1.5, 1.5), h, 1.05))
     cfg = FlowConfig(nu=1.0 / re, advection=scheme, cfl=0.5, fourier=0.2, threads=threads,
                      bc=BoundaryConditions(u_inf=1.0))
     sim = Simulation(grid, cfg)
@@ -99,7 +100,8 @@ def cylinder(re, ppd, t_end, window, threads, scheme):
     t, f = hist.array()
     cd, cl = 2 * f[:, 0, 0], 2 * f[:, 0, 1]
     out = {"case": f"cylinder Re={re}", "ppd": ppd, "cells": grid.nx * grid.ny, "nx": grid.nx, "ny": grid.ny,
-           "t_end": float(sim.t), "steps": sim.n_steps, "wall_s": wall, "blockage": 1.0 / 30,
+           "t_end": float(sim.t), "steps": sim.n_steps, "wall_s": wall, "blockage": 0.5 / half_height,
+           "domain": [-upstream, downstream, -half_height, half_height],
            "advection": scheme}
     if re < 50:
         last = t > t[-1] - 5
@@ -182,6 +184,8 @@ def main(argv=None):
     ap.add_argument("--t-end", type=float, default=40.0)
     ap.add_argument("--window", type=float, default=40.0, help="time window for St and mean C_D")
     ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--domain", type=float, nargs=3, default=[10.0, 20.0, 15.0],
+                    metavar=("UPSTREAM", "DOWNSTREAM", "HALF_HEIGHT"), help="cylinder box in D")
     ap.add_argument("--advection", default="vanleer")
     ap.add_argument("--out", default="out/validation_cfd.jsonl")
     args = ap.parse_args(argv)
@@ -189,7 +193,7 @@ def main(argv=None):
     results = []
     for ppd in args.ppd:
         if args.case == "cylinder":
-            r = cylinder(int(args.re), ppd, args.t_end, args.window, args.threads, args.advection)
+            r = cylinder(int(args.re), ppd, args.t_end, args.window, args.threads, args.advection, *args.domain)
         else:
             r = dfg(ppd, args.t_end, args.threads, args.advection)
         r["command"] = "python tools/validate_cfd.py " + " ".join(argv if argv is not None else sys.argv[1:])
