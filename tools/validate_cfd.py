@@ -6,7 +6,8 @@
 
 Cylinder (diameter D = 1, U = 1): box x in [-10, 20] D (uniform in x), y in [-15, 15] D stretched
 outside |y| < 1.5 D (growth 5 %), uniform inflow, convective outflow, slip sides; blockage
-D/H = 1/30 (``--domain UPSTREAM DOWNSTREAM HALF_HEIGHT`` changes the box). Reported: C_D = 2 F_x/(rho U^2 D) (mean over whole shedding periods when unsteady),
+D/H = 1/30 (``--domain UPSTREAM DOWNSTREAM HALF_HEIGHT`` changes the box).
+Reported: C_D = 2 F_x/(rho U^2 D) (mean over whole shedding periods when unsteady),
 recirculation length L_w/D (last zero of u on the wake centreline, from the rear of the cylinder),
 Strouhal number from the zero up-crossings of C_L over the last ``--window`` time units.
 DFG 2D-1 (Schaefer and Turek 1996): channel 2.2 x 0.41, D = 0.1 at (0.2, 0.2), nu = 1e-3, parabolic
