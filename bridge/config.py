@@ -7,8 +7,9 @@ Two forms exist:
 * an up-scaled bridge (``scenarios/model_c.toml``): ``reference = "great_belt"`` and ``main_span_m = 4000``;
   the up-scaled inputs are computed by :mod:`bridge.upscaling` (thesis 1.5), never typed in.
 
-A third kind, ``kind = "section"``, is a 2-DOF sectional model for flutter checks (see
-:mod:`bridge.flutter.section`).
+Two more kinds run the flutter stage alone: ``kind = "section"``, a 2-DOF sectional model (a
+``[section]`` table, :mod:`bridge.flutter.section`), and ``kind = "modal"``, modes given directly (a
+``[modal]`` table, :class:`bridge.flutter.modal.ModalModel`).
 
 Every value is checked when read: a missing or unknown key, a wrong type or a value outside its range
 raises :class:`bridge.errors.InputError` naming the dotted key, the value and the allowed range.
@@ -320,7 +321,7 @@ class Scenario:
 
 
 # ----------------------------------------------------------------------------------------- parsing
-_KINDS = ("suspension_bridge", "section")
+_KINDS = ("suspension_bridge", "section", "modal")
 
 
 def _box(t: _Table, name: str) -> BoxSection:
@@ -510,17 +511,18 @@ def load_scenario(name_or_path: str | Path, main_span_m: float | None = None,
         return scenario
 
     kind = t.string("kind", _KINDS, default="suspension_bridge")
-    if kind == "section":
+    if kind in ("section", "modal"):
         scenario = Scenario(name=name, kind=kind, description=description, source_path=str(path))
         a = t.table("air", default={})
         scenario = replace(scenario, air=Air(a.number("density_kg_m3", default=1.225),
                                              a.number("kinematic_viscosity_m2_s", default=1.48e-5)))
         a.done()
         scenario = _parse_optional_tables(t, scenario)
-        if scenario.section is None:
-            raise InputError("section", None, "missing: a scenario of kind 'section' needs a [section] table")
+        table = "section" if kind == "section" else "modal"
+        if getattr(scenario, table) is None:
+            raise InputError(table, None, f"missing: a scenario of kind {kind!r} needs a [{table}] table")
         if main_span_m is not None:
-            raise InputError("--main-span", main_span_m, "only applies to bridge scenarios, not to kind 'section'")
+            raise InputError("--main-span", main_span_m, f"only applies to bridge scenarios, not to kind {kind!r}")
         t.done()
         return scenario
 

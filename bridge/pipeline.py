@@ -18,7 +18,7 @@ from .stages import STAGES, RunOptions, StageOutput, resolve_stage
 __all__ = ["plan_stages", "run_stages", "run_scenario", "default_stages"]
 
 # Stages that only make sense for one kind of scenario.
-_KIND_STAGES = {"suspension_bridge": ("cable", "fem", "flutter"), "section": ("flutter",)}
+_KIND_STAGES = {"suspension_bridge": ("cable", "fem", "flutter"), "section": ("flutter",), "modal": ("flutter",)}
 
 
 def default_stages(scenario: Scenario) -> tuple[str, ...]:
@@ -39,8 +39,8 @@ def plan_stages(scenario: Scenario, requested: Iterable[str] | None) -> tuple[st
             return
         needed.add(name)
         for dep in STAGES[name][1]:
-            if scenario.kind == "section" and dep in ("cable", "fem"):
-                continue  # a sectional model carries its own modal data
+            if scenario.kind in ("section", "modal") and dep in ("cable", "fem"):
+                continue  # a sectional model or given modes carry their own modal data
             need(dep)
 
     for name in wanted:

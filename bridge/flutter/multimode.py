@@ -27,7 +27,7 @@ from bridge.flutter.aerodynamics import AerodynamicModel
 from bridge.flutter.determinant import _aero_bracket
 from bridge.flutter.modal import ModalModel
 
-__all__ = ["MultimodeResult", "pk_sweep", "aeroelastic_eigenvalues"]
+__all__ = ["MultimodeResult", "pk_sweep", "aeroelastic_eigenvalues", "static_divergence_speed"]
 
 
 @dataclass(frozen=True)
@@ -149,6 +149,42 @@ def _is_unresolved(model: ModalModel, aero: AerodynamicModel, V: float, s: compl
     return o_lo <= omega <= o_hi
 
 
+def _collapsed(s: np.ndarray, off: np.ndarray) -> np.ndarray:
+    """Flag modes whose tracked eigenvalue is (to 1e-8) another mode's: two rows may not follow one branch;
+    the later mode is the one that lost its own (e.g. after restarting past a gap)."""
+    flag = np.zeros(s.size, dtype=bool)
+    for r in range(s.size):
+        for q in range(r):
+            if not off[q] and not flag[q] and abs(s[r] - s[q]) <= 1e-8 * max(abs(s[q]), 1e-12):
+                flag[r] = True
+    return flag
+
+
+def static_divergence_speed(model: ModalModel, aero: AerodynamicModel, air_density: float,
+                            max_speed_m_s: float) -> float:
+    """Lowest V at which the structure's modal stiffness is cancelled by the steady aerodynamic stiffness:
+    det(diag(m_i w_i^2) - (1/2) rho V^2 L Re[A(Omega -> 0)]) = 0 (Eq 4.24, 4.37 at zero frequency), solved
+    as a generalised eigenproblem for q = (1/2) rho V^2.  NaN if none below ``max_speed_m_s`` or if the
+    aerodynamic model does not reach Omega = 0 (a table starting above it: no extrapolation).
+    Independent of the p-k branch tracking, which loses an overdamped torsional branch near divergence."""
+    from scipy.linalg import eigvals
+
+    o_lo, _ = aero.omega_range
+    s_lo, s_hi = aero.speed_range
+    if o_lo > 1e-3:
+        return float("nan")
+    omega0 = max(o_lo, 1e-6)
+    speed = min(max_speed_m_s, s_hi)
+    K = np.diag(model.modal_masses * model.angular_frequencies**2)
+    A0 = model.deck_length_m * _aero_bracket(model, aero.frf(omega0, speed)).real   # per unit q
+    q = eigvals(K, A0)
+    q = q[np.isfinite(q) & (np.abs(q.imag) <= 1e-9 * np.abs(q)) & (q.real > 0.0)].real
+    if q.size == 0:
+        return float("nan")
+    v = float(np.sqrt(2.0 * q.min() / air_density))
+    return v if s_lo <= v <= max_speed_m_s else float("nan")
+
+
 def _damping(s: np.ndarray) -> np.ndarray:
     return -s.real / np.abs(s)
 
@@ -177,6 +213,7 @@ def pk_sweep(model: ModalModel, aero: AerodynamicModel, air_density: float, max_
     unresolved = []
     for n, V in enumerate(speeds):
         s_new, phi_new, off = aeroelastic_eigenvalues(model, aero, air_density, V, s, phi, tolerance, strict=False)
+        off = off | _collapsed(s_new, off)
         in_range = (s_new.imag >= 0.0) & ~off
         unresolved += [(model.labels[r], float(V)) for r in np.flatnonzero(off & (s_new.imag > 0.0))
                        if _is_unresolved(model, aero, V, s_new[r])]
@@ -211,6 +248,9 @@ def pk_sweep(model: ModalModel, aero: AerodynamicModel, air_density: float, max_
             divergence = float(V_c) if np.isnan(divergence) else divergence
         elif flutter_at is None:
             flutter_at = (float(V_c), s_c, r)
+    static = static_divergence_speed(model, aero, air_density, v_hi)
+    if not np.isnan(static) and (np.isnan(divergence) or static < divergence):
+        divergence = static
     if flutter_at is not None:
         V_c, s_c, r = flutter_at
         return MultimodeResult(flutter=True, critical_speed_m_s=V_c,

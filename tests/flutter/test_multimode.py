@@ -81,3 +81,25 @@ def test_mode_tracking_through_close_frequencies(frequencies_hz):
     pk = pk_sweep(model, Theodorsen(), RHO, 150.0, n_speed=60)
     assert det.flutter and pk.flutter and pk.unstable_mode == "T1"
     assert abs(pk.critical_speed_m_s / det.critical_speed_m_s - 1) < 0.005
+
+
+def test_static_divergence_of_a_torsional_mode_matches_the_closed_form():
+    """Static divergence without relying on p-k branch tracking: for a single torsional mode on a thin plate
+    (h_mtheta(0) = pi/2 about mid-chord, Theodorsen 1935) J w_T^2 = (1/2) rho V^2 B^2 pi/2."""
+    from bridge.flutter.aerodynamics import Theodorsen
+    from bridge.flutter.multimode import static_divergence_speed
+
+    m = ModalModel.from_two_modes(bending_frequency_hz=0.128, torsion_frequency_hz=0.294, a_jj=0.308, a_kk=0.239,
+                                  a_jk=0.038, mass_per_length_kg_m=21.5e3, inertia_per_length_kg_m2_m=2.9e6,
+                                  deck_width_m=31.0, deck_length_m=2694.0)
+    rho, J, w = 1.225, 2.9e6, 2 * np.pi * 0.294
+    single = m.subset([1])
+    expected = np.sqrt(2 * J * w**2 / (rho * 31.0**2 * np.pi / 2))
+    assert static_divergence_speed(single, Theodorsen(), rho, 300.0) == pytest.approx(expected, rel=1e-4)
+    # the coupled pair diverges near that speed too, and the sweep reports it with gaps, never as flutter
+    r = pk_sweep(m, Theodorsen(), rho, 150.0)
+    assert not r.flutter
+    assert r.divergence_speed_m_s == pytest.approx(expected, rel=0.02)
+    # no two modes may follow one branch
+    both = np.isfinite(r.frequency_hz).all(axis=1)
+    assert not np.any(np.isclose(r.frequency_hz[both, 0], r.frequency_hz[both, 1], rtol=1e-9))
