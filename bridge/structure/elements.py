@@ -59,7 +59,8 @@ def _warp():
     import warp as wp
 
     if not _warp_ready:
-        wp.config.quiet = True
+        import kernels  # noqa: F401  (sets Warp's log level before its start-up banner)
+
         wp.init()
         _warp_ready = True
     return wp
