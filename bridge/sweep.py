@@ -92,6 +92,10 @@ def run_case(case: Case, out_dir: str, stages: list[str] | None, quick: bool) ->
     return case.name, "done"
 
 
+def _as_float(value: Any) -> float:
+    return float(value) if isinstance(value, (int, float)) and not isinstance(value, bool) else np.nan
+
+
 def collect(cases: list[Case], cases_dir: Path, sweep_dir: Path, plot_key: str | None) -> Path:
     """Gather every finished case's summary into ``sweep.h5`` and plot ``plot_key`` against the main span."""
     import h5py
@@ -118,9 +122,8 @@ def collect(cases: list[Case], cases_dir: Path, sweep_dir: Path, plot_key: str |
             else:
                 inputs.create_dataset(key, data=np.array([str(v) for v in vals], dtype=h5py.string_dtype()))
         results = h5.create_group("results")
-        for key in numeric:
-            results.create_dataset(key, data=np.array(
-                [float(r.get(key, np.nan)) if r else np.nan for r in rows]))
+        for key in numeric:  # "none" (e.g. no flutter for a pair) and missing values become NaN
+            results.create_dataset(key, data=np.array([_as_float(r.get(key)) if r else np.nan for r in rows]))
     os.replace(tmp, sweep_dir / "sweep.h5")
 
     if plot_key is None:
@@ -135,7 +138,7 @@ def collect(cases: list[Case], cases_dir: Path, sweep_dir: Path, plot_key: str |
         fig = Figure(figsize=(6, 4))
         ax = fig.subplots()
         spans = [r.get("scenario.main_span_m", np.nan) if r else np.nan for r in rows]
-        ys = [r.get(plot_key, np.nan) if r else np.nan for r in rows]
+        ys = [_as_float(r.get(plot_key)) if r else np.nan for r in rows]
         labels = sorted({tuple(c.overrides) for c in cases})
         for lab in labels:
             idx = [i for i, c in enumerate(cases) if tuple(c.overrides) == lab]

@@ -34,3 +34,20 @@ def test_sweep_runs_resumes_and_tabulates(tmp_path, capsys):
 def test_sweep_bad_key_is_input_error(tmp_path, capsys):
     assert main(["great_belt", "--vary", "girder.colour=1,2", "--out", str(tmp_path)]) == 2
     assert "girder.colour" in capsys.readouterr().err
+
+
+def test_collect_tolerates_mixed_numeric_and_text_values(tmp_path):
+    """A key that is a number in one case and "none" in another (a pair without flutter) becomes NaN."""
+    import json
+
+    from bridge.sweep import collect
+
+    cases = plan_cases("great_belt", [1624.0, 2000.0], {})
+    for c, v in zip(cases, [86.5, "none"], strict=True):
+        (tmp_path / "cases" / c.name).mkdir(parents=True)
+        (tmp_path / "cases" / c.name / "summary.json").write_text(json.dumps(
+            {"scenario.main_span_m": c.main_span_m, "flutter.critical_speed_m_s": v}))
+    collect(cases, tmp_path / "cases", tmp_path, None)
+    with h5py.File(tmp_path / "sweep.h5") as h5:
+        got = h5["results/flutter.critical_speed_m_s"][:]
+    assert got[0] == 86.5 and np.isnan(got[1])
