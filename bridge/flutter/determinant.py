@@ -118,6 +118,20 @@ def _normalised_residual(D: np.ndarray) -> float:
     return float(abs(determinant(D)) / (abs(D[0, 0] * D[1, 1]) + abs(D[0, 1] * D[1, 0])))
 
 
+def speed_window(aero, air_density: float, max_speed_m_s: float, min_speed_m_s: float | None) -> tuple[float, float]:
+    """Checked (V_min, V_max) of a flutter search: positive density and speeds, inside the aerodynamic
+    model's V range (a table is never extrapolated); V_min defaults to max(model's V_min, 1 % of V_max)."""
+    check_range("flutter.air_density_kg_m3", air_density, low=0.0, low_open=True)
+    v_hi = check_range("flutter.max_speed_m_s", max_speed_m_s, low=0.0, low_open=True)
+    s_lo, s_hi = aero.speed_range
+    if v_hi > s_hi * (1 + 1e-12):
+        raise InputError("flutter.max_speed_m_s", v_hi,
+                         f"the aerodynamic model covers V in [{s_lo:g}, {s_hi:g}]; no extrapolation")
+    v_lo = max(s_lo, 0.01 * v_hi) if min_speed_m_s is None else check_range(
+        "flutter.min_speed_m_s", min_speed_m_s, low=s_lo, high=v_hi, high_open=True)
+    return v_lo, v_hi
+
+
 def solve_pair(model: ModalModel, aero: AerodynamicModel, air_density: float, max_speed_m_s: float,
                min_speed_m_s: float | None = None, n_speed: int = 120, n_omega: int = 241,
                structural_form: str = "derived", tolerance: float = 1e-10,
@@ -131,14 +145,7 @@ def solve_pair(model: ModalModel, aero: AerodynamicModel, air_density: float, ma
     """
     if model.n_modes != 2:
         raise InputError("flutter.pair", model.labels, "the determinant method takes exactly two modes")
-    check_range("flutter.air_density_kg_m3", air_density, low=0.0, low_open=True)
-    v_hi = check_range("flutter.max_speed_m_s", max_speed_m_s, low=0.0, low_open=True)
-    s_lo, s_hi = aero.speed_range
-    if v_hi > s_hi * (1 + 1e-12):
-        raise InputError("flutter.max_speed_m_s", v_hi,
-                         f"the aerodynamic model covers V in [{s_lo:g}, {s_hi:g}]; no extrapolation")
-    v_lo = max(s_lo, 0.01 * v_hi) if min_speed_m_s is None else check_range(
-        "flutter.min_speed_m_s", min_speed_m_s, low=s_lo, high=v_hi, high_open=True)
+    v_lo, v_hi = speed_window(aero, air_density, max_speed_m_s, min_speed_m_s)
     B = model.deck_width_m
     wi = model.angular_frequencies
     speeds = np.linspace(v_lo, v_hi, int(n_speed))

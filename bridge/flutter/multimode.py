@@ -22,9 +22,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq
 
-from bridge.errors import ConvergenceError, InputError, check_range
+from bridge.errors import ConvergenceError, InputError
 from bridge.flutter.aerodynamics import AerodynamicModel
-from bridge.flutter.determinant import _aero_bracket
+from bridge.flutter.determinant import _aero_bracket, speed_window
 from bridge.flutter.modal import ModalModel
 
 __all__ = ["MultimodeResult", "pk_sweep", "aeroelastic_eigenvalues", "static_divergence_speed"]
@@ -197,14 +197,7 @@ def pk_sweep(model: ModalModel, aero: AerodynamicModel, air_density: float, max_
     if len(keep) < 2:
         raise InputError("flutter.modes", model.labels, "multimode flutter needs >= 2 vertical/torsional modes")
     model = model.subset(keep)
-    check_range("flutter.air_density_kg_m3", air_density, low=0.0, low_open=True)
-    v_hi = check_range("flutter.max_speed_m_s", max_speed_m_s, low=0.0, low_open=True)
-    s_lo, s_hi = aero.speed_range
-    if v_hi > s_hi * (1 + 1e-12):
-        raise InputError("flutter.max_speed_m_s", v_hi,
-                         f"the aerodynamic model covers V in [{s_lo:g}, {s_hi:g}]; no extrapolation")
-    v_lo = max(s_lo, 0.01 * v_hi) if min_speed_m_s is None else check_range(
-        "flutter.min_speed_m_s", min_speed_m_s, low=s_lo, high=v_hi, high_open=True)
+    v_lo, v_hi = speed_window(aero, air_density, max_speed_m_s, min_speed_m_s)
     speeds = np.linspace(v_lo, v_hi, int(n_speed))
     s, phi = 1j * model.angular_frequencies, np.eye(model.n_modes, dtype=np.complex128)
     eig = np.empty((speeds.size, model.n_modes), dtype=np.complex128)
