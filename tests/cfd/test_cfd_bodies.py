@@ -11,6 +11,7 @@ from bridge.cfd import (
     FlowDiverged,
     ForceHistory,
     HarmonicMotion,
+    PrescribedMotion,
     NaNMonitor,
     Simulation,
     Stationary,
@@ -108,3 +109,22 @@ def test_config_rejects_bad_values_naming_the_field(field, value):
     kwargs = {"nu": 0.01, field: value}
     with pytest.raises(ValueError, match=field):
         FlowConfig(**kwargs)
+
+
+def test_rotating_cylinder_feels_only_a_resisting_torque():
+    """Circle spinning about its centre in fluid at rest: by symmetry no net force; the viscous
+    torque opposes the rotation and, once the layer has grown, is of the order of the steady
+    value 4 pi mu Omega R^2 (potential vortex outside; more while the layer is thin)."""
+    n = 16
+    grid = CartesianGrid.uniform(6 * n, 6 * n, (-3.0, 3.0), (-3.0, 3.0))
+    nu, omega = 0.05, 1.0
+    sim = Simulation(grid, FlowConfig(nu=nu, bc=SLIP_BOX))
+    sim.add_body(circle(1.0), PrescribedMotion(lambda t: (0.0, 0.0, omega * t), lambda t: (0.0, 0.0, omega)))
+    sim.set_state(u=0.0, v=0.0)
+    h = ForceHistory()
+    run(sim, 2.0, [h])
+    f = h.array()[1][:, 0]
+    mz = f[-1, 2]
+    steady = 4 * np.pi * nu * omega * 0.5 ** 2
+    assert -5 * steady < mz < -0.5 * steady, (mz, steady)
+    assert np.abs(f[-1, :2]).max() < 1e-6 * abs(mz)
