@@ -185,26 +185,31 @@ def divergence(u: wp.array2d(dtype=wp.float64), v: wp.array2d(dtype=wp.float64),
 @wp.kernel
 def project(ustar: wp.array2d(dtype=wp.float64), vstar: wp.array2d(dtype=wp.float64),
             phi: wp.array2d(dtype=wp.float64), hy_f: wp.array(dtype=wp.float64),
-            dx: wp.float64, c: wp.float64, g: int, nx: int, ny: int, row0: int,
+            dx: wp.float64, c: wp.float64, g: int, nx: int, ny: int, accumulate: int, row0: int,
             u: wp.array2d(dtype=wp.float64), v: wp.array2d(dtype=wp.float64),
             p: wp.array2d(dtype=wp.float64)):
-    """u = u* - c grad(phi) on interior faces (boundary faces copied), p += phi; one cell row."""
+    """u = u* - c grad(phi) on interior faces (boundary faces copied); p = phi, or p += phi when
+    ``accumulate`` (incremental pressure); one cell row."""
     j = row0 + wp.tid()
     J = j + g
     cx = c / dx
     cy = c / hy_f[J]
     u[J, g] = ustar[J, g]
     u[J, g + nx] = ustar[J, g + nx]
-    for i in range(1, nx):
-        u[J, i + g] = ustar[J, i + g] - cx * (phi[j, i] - phi[j, i - 1])
     if j == 0:
         for i in range(nx):
             v[J, i + g] = vstar[J, i + g]
     else:
         for i in range(nx):
             v[J, i + g] = vstar[J, i + g] - cy * (phi[j, i] - phi[j - 1, i])
-    for i in range(nx):
-        p[J, i + g] = p[J, i + g] + phi[j, i]
+    for i in range(1, nx):
+        u[J, i + g] = ustar[J, i + g] - cx * (phi[j, i] - phi[j, i - 1])
+    if accumulate != 0:
+        for i in range(nx):
+            p[J, i + g] = p[J, i + g] + phi[j, i]
+    else:
+        for i in range(nx):
+            p[J, i + g] = phi[j, i]
     if j == ny - 1:
         for i in range(nx):
             v[J + 1, i + g] = vstar[J + 1, i + g]

@@ -72,10 +72,12 @@ class PoissonSolver:
     def solve(self, rhs: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
         """Return phi with D G phi = rhs (mean-free up to the pinned constant); rhs is not modified."""
         w = self.workers
-        if self.uniform:
-            r = sfft.dctn(rhs, type=2, workers=w)
+        if self.uniform:  # one axis at a time: ~10 % faster than dctn/idctn here
+            r = sfft.dct(rhs, type=2, axis=1, workers=w)
+            r = sfft.dct(r, type=2, axis=0, workers=w, overwrite_x=True)
             r *= self.inv_lam
-            phi = sfft.idctn(r, type=2, workers=w, overwrite_x=True)
+            r = sfft.idct(r, type=2, axis=0, workers=w, overwrite_x=True)
+            phi = sfft.idct(r, type=2, axis=1, workers=w, overwrite_x=True)
         else:
             r = sfft.dct(rhs, type=2, axis=1, workers=w)
             r *= self._hc[:, None]

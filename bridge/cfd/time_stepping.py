@@ -203,10 +203,9 @@ class Simulation:
             self.poisson.solve(self._rhs_np, out=self._phi_np)
         else:
             self.phi.assign(self.poisson.solve(self.rhs.numpy()))
-        if self.config.pressure == "full":
-            self.p.zero_()
+        acc = int(self.config.pressure == "incremental")
         self.L.rows(_k.project, ny, 0, [self.u_star, self.v_star, self.phi, self.hy_f, self.grid.dx, c,
-                                        g, nx, ny, ROW0, dst_u, dst_v, self.p])
+                                        g, nx, ny, acc, ROW0, dst_u, dst_v, self.p])
 
     def step(self, dt: float | None = None) -> float:
         """Advance the state by one step (in place); returns the dt used."""
