@@ -3,7 +3,7 @@ symmetric drag, an accelerating body feels the added mass of potential theory (V
 
 import numpy as np
 import pytest
-from helpers import SLIP_BOX
+from cfd_helpers import SLIP_BOX
 
 from bridge.cfd import (
     CartesianGrid,

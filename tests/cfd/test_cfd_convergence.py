@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from helpers import advance, loglog_slope, taylor_green, taylor_green_exact
+from cfd_helpers import advance, loglog_slope, taylor_green, taylor_green_exact
 
 from bridge.cfd.advection import SCHEMES
 

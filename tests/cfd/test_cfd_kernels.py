@@ -4,7 +4,7 @@ Poisson solver identity, signed distance to polygons. Run on cpu and (marker cud
 import numpy as np
 import pytest
 import warp as wp
-from conftest import DEVICES
+from cfd_helpers import DEVICES
 
 from bridge.cfd import CartesianGrid, FlowConfig, PoissonSolver, Simulation, circle, max_divergence, stretched_faces
 from bridge.cfd.advection import SCHEMES

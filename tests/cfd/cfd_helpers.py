@@ -1,8 +1,19 @@
-"""Small builders shared by the CFD tests."""
+"""Small builders shared by the CFD tests (module name unique across test folders: the tests
+import it by name) and the devices to run kernel tests on (cuda only when present)."""
 
 import numpy as np
+import pytest
+import warp as wp
 
 from bridge.cfd import BoundaryConditions, CartesianGrid, FlowConfig, Simulation
+
+wp.config.quiet = True
+
+DEVICES = [
+    pytest.param("cpu", id="cpu"),
+    pytest.param("cuda", id="cuda", marks=[pytest.mark.cuda,
+                                           pytest.mark.skipif(not wp.is_cuda_available(), reason="no CUDA device")]),
+]
 
 SLIP_BOX = BoundaryConditions(left="slip", right="slip", bottom="slip", top="slip")
 
