@@ -2,12 +2,16 @@
 
 Equations: du/dt + div(u u) = -grad p + div(nu_eff (grad u + grad u^T)), div u = 0, with
 nu_eff(x, y) = nu + nu_t a cell-centred field (``Simulation.nu``; a turbulence model writes it).
-Each stage of an explicit SSP Runge-Kutta method (Shu and Osher 1988; "heun" is second order) is an
-incremental pressure-correction step (van Kan 1986):
-  u* = a u^n + b (u_k + dt (A(u_k) + D(u_k) - G p))     predictor (kernels predict_u / predict_v)
+Each stage of an explicit SSP Runge-Kutta method (Shu and Osher 1988; "heun" is second order) is a
+projection step (Chorin 1968):
+  u* = a u^n + b (u_k + dt (A(u_k) + D(u_k) [- G p]))   predictor (kernels yflux_* and predict_*)
   u* on the boundary faces (inflow, convective outflow), then direct forcing by the body
   D G phi = D u* / (b dt)                                 direct Poisson solve (pressure.py)
-  u_{k+1} = u* - b dt G phi,   p <- p + phi               projection (kernel project)
+  u_{k+1} = u* - b dt G phi,   p = phi [p <- p + phi]     projection (kernel project)
+The bracketed terms are the incremental form (van Kan 1986, ``pressure="incremental"``); the default
+"full" form leaves the pressure out of the predictor: with the incremental form the pressure inside an
+immersed body grew without bound (interface blow-up at D/16), the full form is stable and the velocity
+stays second order in time (tests/cfd/test_cfd_convergence.py).
 State arrays are preallocated and mutated in place: stage 1 writes the stage buffers (u_k), the last
 stage overwrites the state (u); ``u_star`` is scratch. Ghosts are refreshed after every projection.
 
