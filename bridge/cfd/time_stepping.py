@@ -1,7 +1,7 @@
 """Projection-method time stepping for 2D incompressible Navier-Stokes, assembled from parts.
 
 Equations: du/dt + div(u u) = -grad p + div(nu_eff (grad u + grad u^T)), div u = 0, with
-nu_eff(x, y) = nu + nu_t a cell-centred field (``Simulation.nu``; a turbulence model writes it).
+nu_eff(x, y) = nu + nu_t a cell-centred field (``Simulation.nu``; a turbulence model sets it with `set_viscosity`).
 Each stage of an explicit SSP Runge-Kutta method (Shu and Osher 1988; "heun" is second order) is a
 projection step (Chorin 1968):
   u* = a u^n + b (u_k + dt (A(u_k) + D(u_k) [- G p]))   predictor (kernels yflux_* and predict_*)
@@ -134,6 +134,23 @@ class Simulation:
         self.bodies.append(body)
         self.last_force.append(np.zeros(3))
         return body
+
+    def set_viscosity(self, nu_eff) -> None:
+        """Effective viscosity nu + nu_t on the cells (the turbulence-model plug-in).
+
+        ``nu_eff``: a Warp or NumPy array of the cell storage shape (ny+2G, nx+2G), ghosts included
+        (the stress uses the first ghost layer), or an (ny, nx) interior array whose ghosts are then
+        copied from the nearest interior cell. Updates ``nu_max`` for the viscous time-step limit.
+        """
+        g, nx, ny = GHOST, self.grid.nx, self.grid.ny
+        host = nu_eff.numpy() if isinstance(nu_eff, wp.array) else np.asarray(nu_eff, dtype=float)
+        if host.shape == (ny, nx):
+            host = np.pad(host, g, mode="edge")
+        if host.shape != self.nu.shape or not np.all(host > 0):
+            raise ValueError(f"nu_eff: need positive values of shape {(ny, nx)} or {self.nu.shape}, "
+                             f"got shape {host.shape}")
+        self.nu.assign(host)
+        self.nu_max = float(host.max())
 
     # --- initialisation ---------------------------------------------------------------------------
     def set_state(self, u=None, v=None, p=None, t: float = 0.0):

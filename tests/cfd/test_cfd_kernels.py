@@ -40,7 +40,7 @@ def test_warp_step_matches_numpy_reference(device, grid_kind, scheme, pressure):
     ref = NumpyFlow(grid, cfg)
     nu = 0.01 * (1 + np.random.default_rng(1).random(ref.nu.shape))
     ref.nu[...] = nu
-    sim.nu.assign(nu)
+    sim.set_viscosity(nu)
     for name in "uvp":
         getattr(ref, name)[...] = getattr(sim, name).numpy()
     for _ in range(3):
@@ -104,3 +104,14 @@ def test_polygon_properties_of_a_circle():
     assert p.area == pytest.approx(np.pi, rel=1e-12)
     assert np.allclose(p.centroid, 0.0, atol=1e-12)
     assert p.polar_moment_centroid == pytest.approx(np.pi / 2, rel=1e-4)  # pi R^4 / 2, R = 1
+
+
+def test_set_viscosity_checks_shape_and_sign():
+    grid = GRIDS["uniform"]()
+    sim = Simulation(grid, FlowConfig(nu=0.01))
+    sim.set_viscosity(np.full(grid.shape, 0.03))
+    assert sim.nu_max == pytest.approx(0.03) and np.allclose(sim.nu.numpy(), 0.03)
+    with pytest.raises(ValueError, match="nu_eff"):
+        sim.set_viscosity(np.zeros(grid.shape))
+    with pytest.raises(ValueError, match="nu_eff"):
+        sim.set_viscosity(np.ones((3, 3)))
