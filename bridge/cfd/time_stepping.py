@@ -1,7 +1,8 @@
 """Projection-method time stepping for 2D incompressible Navier-Stokes, assembled from parts.
 
 Equations: du/dt + div(u u) = -grad p + div(nu_eff (grad u + grad u^T)), div u = 0, with
-nu_eff(x, y) = nu + nu_t a cell-centred field (``Simulation.nu``; a turbulence model sets it with `set_viscosity`).
+nu_eff(x, y) = nu + nu_t a cell-centred field (``Simulation.nu``, set by a turbulence model through
+``Simulation.set_viscosity``).
 Each stage of an explicit SSP Runge-Kutta method (Shu and Osher 1988; "heun" is second order) is a
 projection step (Chorin 1968):
   u* = a u^n + b (u_k + dt (A(u_k) + D(u_k) [- G p]))   predictor (kernels yflux_* and predict_*)
