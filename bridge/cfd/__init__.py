@@ -1,8 +1,7 @@
 """2D incompressible laminar Navier-Stokes on Cartesian MAC grids with immersed rigid bodies.
 
 Public API: build a ``CartesianGrid``, a ``FlowConfig`` (with ``BoundaryConditions``), a ``Simulation``,
-bodies
-(``Simulation.add_body`` with a ``Polygon`` and a motion), then ``run`` with monitors.
+bodies (``Simulation.add_body`` with a ``Polygon`` and a motion), then ``run`` with monitors.
 Plug-in points for later issues: ``Simulation.set_viscosity`` (cell field nu + nu_t from a turbulence
 model before each step), the grid object (metrics), the Poisson solver object, body motions
 (anything with ``pose(t)``/``velocity(t)``). See docs/cfd.md.
