@@ -80,14 +80,14 @@ def main() -> None:
     es = model.elements
     big = ElementSet(*(np.tile(x, (a.tile, 1)) for x in (es.xa, es.xb, es.orient, es.props)))
     element_matrices(es)  # warm-up: compile or load the kernel module
-    print(f"## FEM assembly and eigen solve\n")
+    print("## FEM assembly and eigen solve\n")
     print(f"Great Belt, {DEFAULT_ELEMENTS_PER_PANEL} elements per hanger panel: {len(es)} elements, "
           f"{assemble(model).n_dof} DOFs.  Medians of {a.repeats} runs; Warp on the CPU device, float64.\n")
     print("| step | elements | time [ms] | elements/s |")
     print("|---|---|---|---|")
     for label, elements in (("GB model", es), (f"GB x{a.tile}", big)):
-        tw = _median_time(lambda: element_matrices(elements), a.repeats)
-        tn = _median_time(lambda: element_matrices_numpy(elements), a.repeats)
+        tw = _median_time(lambda elements=elements: element_matrices(elements), a.repeats)
+        tn = _median_time(lambda elements=elements: element_matrices_numpy(elements), a.repeats)
         print(f"| element matrices K, M, K_G, Warp kernel ({label}) | {len(elements)} | {1e3 * tw:.2f} | "
               f"{len(elements) / tw:.3g} |")
         print(f"| element matrices K, M, K_G, vectorised NumPy ({label}) | {len(elements)} | {1e3 * tn:.2f} | "

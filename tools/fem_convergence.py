@@ -9,7 +9,8 @@ bridge.structure.analysis must be at least that).  Prints a Markdown table (docs
 
 ``--sensitivity`` adds the support variants discussed in docs/structure.md (same mesh): pylon tops
 (cable saddles) held longitudinally, girder free longitudinally at one end, girder free vertically
-at the pylons, pylon legs turned by 90 degrees, pylon concrete twice as stiff.  These are diagnostics of which assumption moves which frequency, not model options.
+at the pylons, pylon legs turned by 90 degrees, pylon concrete twice as stiff.  These are diagnostics of which
+assumption moves which frequency, not model options.
 """
 
 from __future__ import annotations
@@ -46,7 +47,7 @@ def study(name: str, n_max: int = 16, n_modes: int = 30) -> list[dict]:
                      "S-T1": r.frequency("S-T1") if "S-T1" in r.labels else nan, "pair": pair,
                      "time": time.perf_counter() - t})
         n *= 2
-    for a, b in zip(rows[:-1], rows[1:]):
+    for a, b in zip(rows[:-1], rows[1:], strict=False):
         a["change"] = float(np.max(np.abs(b["f"] / a["f"] - 1.0)))
     return rows
 

@@ -68,7 +68,9 @@ def constraint_transform(model: FrameModel) -> sp.csr_matrix:
     col[free] = np.arange(free.sum())
     rows, cols, vals = [], [], []
     fr = np.flatnonzero(free.ravel())
-    rows.append(fr); cols.append(col.ravel()[fr]); vals.append(np.ones(len(fr)))
+    rows.append(fr)
+    cols.append(col.ravel()[fr])
+    vals.append(np.ones(len(fr)))
     for s, m in model.links:
         r = model.nodes[s] - model.nodes[m]
         # u_s = u_m + theta_m x r ; theta x r = (ty rz - tz ry, tz rx - tx rz, tx ry - ty rx)
@@ -77,7 +79,9 @@ def constraint_transform(model: FrameModel) -> sp.csr_matrix:
                 (3, 3): 1.0, (4, 4): 1.0, (5, 5): 1.0}
         for (ds, dm), c in coef.items():
             if c != 0.0 and col[m, dm] >= 0:
-                rows.append(np.array([6 * s + ds])); cols.append(np.array([col[m, dm]])); vals.append(np.array([c]))
+                rows.append(np.array([6 * s + ds]))
+                cols.append(np.array([col[m, dm]]))
+                vals.append(np.array([c]))
     return sp.coo_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
                          shape=(6 * n, int(free.sum()))).tocsr()
 

@@ -60,8 +60,22 @@ import numpy as np
 from ..cable import CableSolution
 from ..config import GRAVITY_M_S2, BoxSection, Scenario
 from ..errors import InputError
-from .elements import (KIND_BEAM, KIND_CABLE, N_PROPS, PROP_AXIAL, PROP_EA, PROP_EI2, PROP_EI3, PROP_GJ,
-                       PROP_KIND, PROP_MASS, PROP_POLAR, PROP_ROT2, PROP_ROT3, ElementSet)
+from .elements import (
+    KIND_BEAM,
+    KIND_CABLE,
+    N_PROPS,
+    PROP_AXIAL,
+    PROP_EA,
+    PROP_EI2,
+    PROP_EI3,
+    PROP_GJ,
+    PROP_KIND,
+    PROP_MASS,
+    PROP_POLAR,
+    PROP_ROT2,
+    PROP_ROT3,
+    ElementSet,
+)
 
 __all__ = ["FrameModel", "build_model", "GROUPS"]
 
@@ -119,8 +133,12 @@ class _Builder:
         return len(self.nodes) - 1
 
     def element(self, a: int, b: int, orient: np.ndarray, props: np.ndarray, group: str) -> None:
-        self.xa.append(self.nodes[a]); self.xb.append(self.nodes[b]); self.ov.append(orient)
-        self.props.append(props); self.conn.append((a, b)); self.group.append(GROUPS.index(group))
+        self.xa.append(self.nodes[a])
+        self.xb.append(self.nodes[b])
+        self.ov.append(orient)
+        self.props.append(props)
+        self.conn.append((a, b))
+        self.group.append(GROUPS.index(group))
 
 
 def _beam_props(E: float, G: float, area: float, i2: float, i3: float, torsion: float, mass: float,
@@ -150,7 +168,7 @@ def _levels(breaks: list[float], max_len: float) -> np.ndarray:
     """Sorted unique levels with every gap split into pieces no longer than max_len."""
     b = np.unique(np.round(np.asarray(breaks, dtype=np.float64), 9))
     out = [b[0]]
-    for lo, hi in zip(b[:-1], b[1:]):
+    for lo, hi in zip(b[:-1], b[1:], strict=False):
         k = max(1, int(np.ceil((hi - lo) / max_len - 1e-9)))
         out.extend(lo + (hi - lo) * np.arange(1, k + 1) / k)
     return np.array(out)
@@ -183,7 +201,7 @@ def build_model(scenario: Scenario, cables: CableSolution, n_sub: int = 4) -> Fr
     # cable node elevations: the statics elevation at panel points (hangers, pylons, anchors); between
     # them the funicular polygon of the cable's own weight (exact nodal equilibrium, see _sub_polygon)
     panel_y = np.empty(len(panel_points))
-    for sp, (lo, hi) in zip(cables.spans, ((0.0, side), (side, side + span), (side + span, total))):
+    for sp, (lo, hi) in zip(cables.spans, ((0.0, side), (side, side + span), (side + span, total)), strict=False):
         sel = (panel_points >= lo - 1e-9) & (panel_points <= hi + 1e-9)
         panel_y[sel] = np.interp(panel_points[sel], sp.z_m, sp.elevation_m)  # panel points are RK4 nodes
     mass_of_panel = np.where((panel_points[:-1] >= side - 1e-9) & (panel_points[1:] <= side + span + 1e-9),
@@ -264,14 +282,14 @@ def build_model(scenario: Scenario, cables: CableSolution, n_sub: int = 4) -> Fr
 
     # compression at each level: cable + leg weight above + half the cross beams at or above
     seg_weight = np.array([g * rho_c * leg_section(0.5 * (lo + hi)).area_m2 * (hi - lo)
-                           for lo, hi in zip(levels[:-1], levels[1:])])
+                           for lo, hi in zip(levels[:-1], levels[1:], strict=False)])
     for ip in range(2):
         for s in range(2):
             nodes = legs[ip, s]
             for k in range(len(levels) - 1):
                 y_mid = 0.5 * (levels[k] + levels[k + 1])
                 above = seg_weight[k + 1:].sum() + 0.5 * seg_weight[k] + 0.5 * sum(
-                    w for w, yb in zip(cross_weight, beams) if yb > y_mid)
+                    w for w, yb in zip(cross_weight, beams, strict=False) if yb > y_mid)
                 sec = leg_section(y_mid)
                 # legs: local e1 up, e2 = global z (along the bridge), e3 = global x (across);
                 # deflection along z bends about the axis parallel to side b (across): i_about_b
@@ -280,7 +298,7 @@ def build_model(scenario: Scenario, cables: CableSolution, n_sub: int = 4) -> Fr
                                     axial=-(v_top + above))
                 b.element(nodes[k], nodes[k + 1], ALONG, props,
                           "pylon_lower_leg" if sec is pyl.lower_leg else "pylon_upper_leg")
-        for yb, sec in zip(beams, sec_cross):
+        for yb, sec in zip(beams, sec_cross, strict=False):
             k = int(np.argmin(abs(levels - yb)))
             a_node, b_node = legs[ip, 0][k], legs[ip, 1][k]
             n_cb = 4
@@ -289,7 +307,7 @@ def build_model(scenario: Scenario, cables: CableSolution, n_sub: int = 4) -> Fr
             # cross beams: e1 across, e2 up; vertical deflection bends about the axis parallel to a
             props = _beam_props(E_c, G_c, sec.area_m2, sec.i_about_a_m4, sec.i_about_b_m4,
                                 sec.torsion_constant_m4, rho_c * sec.area_m2, rho_c)
-            for c0, c1 in zip(chain[:-1], chain[1:]):
+            for c0, c1 in zip(chain[:-1], chain[1:], strict=False):
                 b.element(c0, c1, UP, props, "pylon_cross_beam")
 
     nodes = np.array(b.nodes)

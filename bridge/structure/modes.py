@@ -9,7 +9,8 @@ with the deck's mu and J of Eq 4.7 as weights (trapezoidal integration along z):
 the largest share names the mode; if the deck energy (the sum of the four terms, i.e. the girder with
 the cable mass moving with it as Eq 4.7 assumes) is below ``CABLE_SHARE`` of the mode's total kinetic
 energy phi^T M phi, the mode is a "cable" mode (cables, hangers or pylons move, the deck barely does).
-The ratio can exceed 1 slightly where the cables swing less than the deck (lateral modes).  Symmetry about mid-span: the dominant field f(z) is compared with its mirror
+The ratio can exceed 1 slightly where the cables swing less than the deck (lateral modes).  Symmetry about
+mid-span: the dominant field f(z) is compared with its mirror
 f(2 z_mid - z); correlation > 0 is "S", < 0 "SS".
 
 Normalisation (Eq 4.31-4.32): vertical modes max|U| = 1, torsional max|Theta| = 1, lateral max|V| = 1,
@@ -148,7 +149,7 @@ def classify_modes(scenario: Scenario, frequencies_hz: np.ndarray, shapes_full: 
         shapes[:, i] = ph / ref
     counters: dict[tuple[str, str], int] = {}
     labels = []
-    for k, s in zip(kinds, syms):
+    for k, s in zip(kinds, syms, strict=False):
         counters[k, s] = counters.get((k, s), 0) + 1
         labels.append(f"{s}-{_KIND_LETTER[k]}{counters[k, s]}")
     modal_masses = np.einsum("di,di->i", shapes, mass_full @ shapes)

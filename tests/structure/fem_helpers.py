@@ -7,8 +7,20 @@ import pytest
 import scipy.linalg as sla
 
 from bridge.structure.assembly import global_matrices
-from bridge.structure.elements import (KIND_BEAM, KIND_CABLE, N_PROPS, PROP_AXIAL, PROP_EA, PROP_EI2, PROP_EI3,
-                                       PROP_GJ, PROP_KIND, PROP_MASS, PROP_POLAR, ElementSet)
+from bridge.structure.elements import (
+    KIND_BEAM,
+    KIND_CABLE,
+    N_PROPS,
+    PROP_AXIAL,
+    PROP_EA,
+    PROP_EI2,
+    PROP_EI3,
+    PROP_GJ,
+    PROP_KIND,
+    PROP_MASS,
+    PROP_POLAR,
+    ElementSet,
+)
 
 
 def _cuda_available() -> bool:

@@ -64,7 +64,7 @@ def test_normalisation_and_symmetry(great_belt):
     _, _, r = great_belt
     m = r.modes
     mirror = 2 * m.mid_span_z_m - m.z_m
-    for i, (kind, sym) in enumerate(zip(m.kinds, m.symmetries)):
+    for i, (kind, sym) in enumerate(zip(m.kinds, m.symmetries, strict=False)):
         field = {"vertical": m.U, "torsional": m.Theta, "lateral": m.V}.get(kind)
         if field is None:
             continue

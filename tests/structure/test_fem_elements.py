@@ -36,7 +36,7 @@ def rigid_body_modes(xa: np.ndarray, xb: np.ndarray) -> np.ndarray:
 @pytest.mark.parametrize("device", DEVICES)
 def test_warp_matches_numpy_twin(device):
     es = random_elements(40)
-    for a, b in zip(element_matrices(es, device=device), element_matrices_numpy(es)):
+    for a, b in zip(element_matrices(es, device=device), element_matrices_numpy(es), strict=False):
         assert np.allclose(a, b, rtol=1e-13, atol=1e-13 * np.abs(b).max())
 
 
@@ -82,7 +82,7 @@ def test_frame_invariance():
         np.array([[1, 0, 0], [0, np.cos(1.1), -np.sin(1.1)], [0, np.sin(1.1), np.cos(1.1)]])
     rot = ElementSet(es.xa @ Q.T, es.xb @ Q.T, es.orient @ Q.T, es.props.copy())
     T = np.kron(np.eye(4), Q)
-    for a, b in zip(element_matrices(es), element_matrices(rot)):
+    for a, b in zip(element_matrices(es), element_matrices(rot), strict=False):
         for e in range(len(es)):
             assert np.allclose(T.T @ b[e] @ T, a[e], rtol=1e-12, atol=1e-12 * np.abs(a[e]).max())
 
