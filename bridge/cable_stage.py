@@ -20,7 +20,7 @@ def cable_summary(s: Scenario, c: CableSolution) -> dict[str, float | int | str]
         "scenario.sag_m": g.sag_m,
         "scenario.pylon_height_m": g.pylon_height_m,
         "scenario.extra_cross_beams": s.pylon.extra_cross_beams,
-        "scenario.pylon_leg_inertia_ratio": s.pylon.lower_leg.i_about_a_m4 / _reference_leg_inertia(s),
+        "scenario.pylon_leg_inertia_ratio": s.pylon_inertia_ratio,
         "scenario.deck_mass_per_length_kg_m": s.deck_mass_per_length_kg_m,
         "scenario.deck_inertia_per_length_kg_m2_m": s.deck_inertia_per_length_kg_m2_m,
         "cable.area_m2": s.cable.area_m2,
@@ -46,15 +46,6 @@ def cable_summary(s: Scenario, c: CableSolution) -> dict[str, float | int | str]
         "cable.equilibrium_residual": c.equilibrium_residual,
         "cable.first_vertical_frequency_eq_3_2_hz": c.first_vertical_frequency_estimate_hz,
     }
-
-
-def _reference_leg_inertia(s: Scenario) -> float:
-    """Lower-leg inertia of the reference bridge (the scenario itself when it is not up-scaled)."""
-    if s.reference_name is None:
-        return s.pylon.lower_leg.i_about_a_m4
-    from .config import load_scenario
-
-    return load_scenario(s.reference_name).pylon.lower_leg.i_about_a_m4
 
 
 def cable_figures(s: Scenario, c: CableSolution) -> dict:

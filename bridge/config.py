@@ -294,6 +294,7 @@ class Scenario:
     damping: tuple[DampingEntry, ...] = ()
     air: Air = Air()
     reference_name: str | None = None
+    pylon_inertia_ratio: float = 1.0  # I/I0 of Eq 1.3 applied when this bridge was up-scaled (1: not up-scaled)
     source_path: str | None = None
     flutter: Any = None   # bridge.flutter.options.FlutterOptions
     section: Any = None   # bridge.flutter.section.SectionModel (kind == "section")
@@ -332,6 +333,15 @@ def _box(t: _Table, name: str) -> BoxSection:
         raise InputError(s.key(err.key.split(".")[-1]), err.value, err.allowed) from None
     s.done()
     return box
+
+
+def _air(t: _Table) -> Air:
+    """The optional [air] table (thesis 5.2.4 values as defaults)."""
+    a = t.table("air", default={})
+    air = Air(a.number("density_kg_m3", default=Air.density_kg_m3),
+              a.number("kinematic_viscosity_m2_s", default=Air.kinematic_viscosity_m2_s))
+    a.done()
+    return air
 
 
 def _materials(t: _Table) -> dict[str, Material]:
@@ -411,9 +421,7 @@ def _parse_bridge(t: _Table, name: str, description: str, source: str | None) ->
         r.done()
     d.done()
 
-    a = t.table("air", default={})
-    air = Air(a.number("density_kg_m3", default=1.225), a.number("kinematic_viscosity_m2_s", default=1.48e-5))
-    a.done()
+    air = _air(t)
 
     return Scenario(name=name, kind="suspension_bridge", description=description, geometry=geometry,
                     girder=girder, cable=cable, hanger=hanger, pylon=pylon, materials=materials,
@@ -513,10 +521,7 @@ def load_scenario(name_or_path: str | Path, main_span_m: float | None = None,
     kind = t.string("kind", _KINDS, default="suspension_bridge")
     if kind in ("section", "modal"):
         scenario = Scenario(name=name, kind=kind, description=description, source_path=str(path))
-        a = t.table("air", default={})
-        scenario = replace(scenario, air=Air(a.number("density_kg_m3", default=1.225),
-                                             a.number("kinematic_viscosity_m2_s", default=1.48e-5)))
-        a.done()
+        scenario = replace(scenario, air=_air(t))
         scenario = _parse_optional_tables(t, scenario)
         table = "section" if kind == "section" else "modal"
         if getattr(scenario, table) is None:

@@ -92,7 +92,8 @@ def upscale(reference: Scenario, main_span_m: float) -> Scenario:
         hanger_spacing_target_m=g0.hanger_spacing_target_m, cable_plane_spacing_m=g0.cable_plane_spacing_m,
         girder_elevation_m=g0.girder_elevation_m * s, pylon_height_m=g0.pylon_height_m * s)
 
-    f = pylon_inertia_ratio(reference, cable.mass_per_length_main_kg_m, main_span_m) ** 0.25
+    inertia_ratio = pylon_inertia_ratio(reference, cable.mass_per_length_main_kg_m, main_span_m)
+    f = inertia_ratio ** 0.25
     pylon = Pylon(
         lower_leg=p0.lower_leg.scaled(f), upper_leg=p0.upper_leg.scaled(f),
         lower_cross_beam=p0.lower_cross_beam.scaled(f), upper_cross_beam=p0.upper_cross_beam.scaled(f),
@@ -101,5 +102,5 @@ def upscale(reference: Scenario, main_span_m: float) -> Scenario:
         extra_cross_beams=p0.extra_cross_beams + extra_cross_beams(main_span_m), material=p0.material)
 
     return replace(reference, name=f"{reference.name}_L{main_span_m:g}", geometry=geometry, cable=cable,
-                   pylon=pylon, reference_name=reference.name,
+                   pylon=pylon, reference_name=reference.name, pylon_inertia_ratio=inertia_ratio,
                    description=f"{reference.name} up-scaled to main span {main_span_m:g} m")

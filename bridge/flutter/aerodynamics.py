@@ -70,8 +70,15 @@ def _check_within(key: str, values: np.ndarray, low: float, high: float, what: s
         raise InputError(key, bad, f"{what} covers [{low:g}, {high:g}]; no extrapolation")
 
 
+class _ClosedForm:
+    """A closed-form model: defined for every Omega >= 0 and V >= 0, so nothing is extrapolated."""
+
+    omega_range: tuple[float, float] = (0.0, np.inf)
+    speed_range: tuple[float, float] = (0.0, np.inf)
+
+
 @dataclass(frozen=True)
-class Theodorsen:
+class Theodorsen(_ClosedForm):
     """Thin flat plate, moment about mid-chord (a = 0), k = Omega / 2.
 
     Derived from Theodorsen's lift and moment (h down, L up, alpha nose-up) with u = -h:
@@ -83,14 +90,6 @@ class Theodorsen:
     """
 
     name: str = "theodorsen"
-
-    @property
-    def omega_range(self) -> tuple[float, float]:
-        return (0.0, np.inf)
-
-    @property
-    def speed_range(self) -> tuple[float, float]:
-        return (0.0, np.inf)
 
     def frf(self, omega, speed) -> FRF:
         omega, speed = np.broadcast_arrays(np.asarray(omega, dtype=np.float64),
@@ -104,7 +103,7 @@ class Theodorsen:
 
 
 @dataclass(frozen=True)
-class QuasiSteady:
+class QuasiSteady(_ClosedForm):
     """Quasi-steady FRFs from static coefficients (reference length B for all of them).
 
     Effective angle of attack alpha_e = theta - udot/V; the drag, tilted by -udot/V, adds to the lift:
@@ -126,14 +125,6 @@ class QuasiSteady:
             object.__setattr__(self, key, check_range(f"flutter.quasi_steady.{key}", getattr(self, key)))
         object.__setattr__(self, "drag_coefficient",
                            check_range("flutter.quasi_steady.drag_coefficient", self.drag_coefficient, low=0.0))
-
-    @property
-    def omega_range(self) -> tuple[float, float]:
-        return (0.0, np.inf)
-
-    @property
-    def speed_range(self) -> tuple[float, float]:
-        return (0.0, np.inf)
 
     def frf(self, omega, speed) -> FRF:
         omega, _ = np.broadcast_arrays(np.asarray(omega, dtype=np.float64), np.asarray(speed, dtype=np.float64))

@@ -81,3 +81,16 @@ def test_any_span_and_geometric_similarity():
     assert s.geometry.pylon_height_m == pytest.approx(ref.geometry.pylon_height_m * k)
     assert s.geometry.sag_ratio == pytest.approx(ref.geometry.sag_ratio)
     assert math.isclose(s.cable.density_kg_m3, ref.cable.density_kg_m3)
+
+
+def test_reported_pylon_inertia_ratio_is_the_applied_one_also_with_overrides():
+    """The summary's I/I0 is the one the up-scaling applied, also when a sweep overrides reference inputs."""
+    from bridge.cable import solve_cables
+    from bridge.cable_stage import cable_summary
+
+    for over in ({}, {"girder.mass_per_length_kg_m": 20000.0}):
+        ref = load_scenario("great_belt", overrides=over)
+        s = load_scenario("model_b", overrides=over)
+        got = cable_summary(s, solve_cables(s))["scenario.pylon_leg_inertia_ratio"]
+        assert got == pytest.approx(s.pylon.lower_leg.i_about_a_m4 / ref.pylon.lower_leg.i_about_a_m4, rel=1e-9)
+    assert load_scenario("great_belt").pylon_inertia_ratio == 1.0
