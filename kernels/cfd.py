@@ -368,14 +368,15 @@ def rigid_velocity(x: wp.float64, y: wp.float64, pos: wp.vec3d, vel: wp.vec3d, c
 def ib_targets(q: wp.array2d(dtype=wp.float64), phi: wp.array2d(dtype=wp.float64),
                x0: wp.float64, dx: wp.float64, xoff: wp.float64, yc: wp.array(dtype=wp.float64),
                pos: wp.vec3d, vel: wp.vec3d, comp: int, i0: int, j0: int, ni: int,
-               ilo: int, ihi: int, jlo: int, jhi: int,
+               ilo: int, ihi: int, jlo: int, jhi: int, order: int,
                target: wp.array2d(dtype=wp.float64), state: wp.array2d(dtype=wp.int32)):
     """Direct-forcing target of each face in the box (state: 0 fluid, 1 solid, 2 interface).
 
     Solid faces (phi <= 0) take the rigid-body velocity. Fluid faces with a solid neighbour along a
     grid line take the linear interpolation (Fadlun et al. 2000) between the body velocity at the
     interface point (distance d found from phi along the line) and the next fluid face:
-    q_f = q_b + (q_o - q_b) d / (d + h); estimates from several lines are averaged.
+    q_f = q_b + (q_o - q_b) d / (d + h) (``order`` 1), or the quadratic through q_b, q_o and the face
+    after q_o (``order`` 2); estimates from several lines are averaged.
     Only faces with ilo <= I < ihi and jlo <= J < jhi are updated (boundary faces excluded);
     reads ``q`` and writes ``target``/``state`` only, so the result does not depend on order.
     """
@@ -420,7 +421,18 @@ def ib_targets(q: wp.array2d(dtype=wp.float64), phi: wp.array2d(dtype=wp.float64
                         ho = h
                         if dj != 0:
                             ho = wp.abs(yc[J - dj] - yc[J])
-                        acc += qb + (qo - qb) * d / (d + ho)
+                        if order == 2:
+                            # quadratic through the wall point and the next two faces on the line
+                            qoo = q[J - 2 * dj, I - 2 * di]
+                            hoo = h
+                            if dj != 0:
+                                hoo = wp.abs(yc[J - 2 * dj] - yc[J - dj])
+                            s1 = d + ho
+                            s2 = s1 + hoo
+                            acc += qb * (s1 - d) * (s2 - d) / (s1 * s2) \
+                                + qo * d * (s2 - d) / (s1 * hoo) - qoo * d * (s1 - d) / (s2 * hoo)
+                        else:
+                            acc += qb + (qo - qb) * d / (d + ho)
                         cnt += wp.float64(1.0)
                 if cnt > wp.float64(0.0):
                     st = 2
@@ -433,9 +445,13 @@ def ib_targets(q: wp.array2d(dtype=wp.float64), phi: wp.array2d(dtype=wp.float64
 def ib_apply(q: wp.array2d(dtype=wp.float64), target: wp.array2d(dtype=wp.float64),
              state: wp.array2d(dtype=wp.int32), x0: wp.float64, dx: wp.float64, xoff: wp.float64,
              yc: wp.array(dtype=wp.float64), hy: wp.array(dtype=wp.float64), pos: wp.vec3d,
-             comp: int, i0: int, j0: int, ni: int, slot: int, acc: wp.array(dtype=wp.float64)):
+             comp: int, i0: int, j0: int, ni: int, slot: int, p: wp.array2d(dtype=wp.float64),
+             hy_f: wp.array(dtype=wp.float64), cgrad: wp.float64, compensate: int,
+             acc: wp.array(dtype=wp.float64)):
     """q = target on forced faces; acc[3 slot + comp] += momentum added (per unit density),
-    acc[3 slot + 2] += its moment about pos[0:2]. ``hy`` is the face control-volume height."""
+    acc[3 slot + 2] += its moment about pos[0:2]. ``hy`` is the face control-volume height.
+    ``compensate``: the target is raised by cgrad * (grad p)_face (``hy_f``: v-face spacing), so the
+    projection with factor cgrad brings the face back to the target (bridge.cfd.immersed)."""
     jb = wp.tid()
     J = j0 + jb
     mom = wp.float64(0.0)
@@ -443,8 +459,14 @@ def ib_apply(q: wp.array2d(dtype=wp.float64), target: wp.array2d(dtype=wp.float6
     for ib in range(ni):
         if state[jb, ib] != 0:
             I = i0 + ib
-            dq = (target[jb, ib] - q[J, I]) * dx * hy[J]
-            q[J, I] = target[jb, ib]
+            tq = target[jb, ib]
+            if compensate != 0:
+                if comp == 0:
+                    tq += cgrad * (p[J, I] - p[J, I - 1]) / dx
+                else:
+                    tq += cgrad * (p[J, I] - p[J - 1, I]) / hy_f[J]
+            dq = (tq - q[J, I]) * dx * hy[J]
+            q[J, I] = tq
             mom += dq
             if comp == 0:
                 mz -= (yc[J] - pos[1]) * dq

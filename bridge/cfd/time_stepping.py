@@ -7,6 +7,7 @@ Each stage of an explicit SSP Runge-Kutta method (Shu and Osher 1988; "heun" is 
 projection step (Chorin 1968):
   u* = a u^n + b (u_k + dt (A(u_k) + D(u_k) [- G p]))   predictor (kernels yflux_* and predict_*)
   u* on the boundary faces (inflow, convective outflow), then direct forcing by the body
+    (forced faces = target + b dt G p, so that the projection leaves them at the target; immersed.py)
   D G phi = D u* / (b dt)                                 direct Poisson solve (pressure.py)
   u_{k+1} = u* - b dt G phi,   p = phi [p <- p + phi]     projection (kernel project)
 The bracketed terms are the incremental form (van Kan 1986, ``pressure="incremental"``); the default
@@ -238,13 +239,17 @@ class Simulation:
             body.reset_impulse()
         src_u, src_v = self.u, self.v
         n = len(self.stages)
+
+        def compensation(c):  # forced faces pre-compensated by c G p ("full" form only; see immersed.py)
+            return (self.p, c) if self.config.pressure == "full" else (None, 0.0)
+
         for k, (a, b) in enumerate(self.stages):
             last = k == n - 1
             dst_u, dst_v = (self.u, self.v) if last else (self.u_stage, self.v_stage)
             self._predict(src_u, src_v, self.u, self.v, dt, a, b)
             self.bc.set_normal_faces(self.u, src_u, self.u_star, t_new, dt, a, b)
             for body in self.bodies:
-                body.apply(self.u_star, self.v_star, k)
+                body.apply(self.u_star, self.v_star, k, *compensation(b * dt))
             self._project(dst_u, dst_v, b * dt)
             self.bc.fill_ghosts(dst_u, dst_v)
             src_u, src_v = dst_u, dst_v
