@@ -482,3 +482,31 @@ def fill_rows(q: wp.array2d(dtype=wp.float64), value: wp.float64):
     J = wp.tid()
     for I in range(q.shape[1]):
         q[J, I] = value
+
+
+@wp.kernel
+def tridiag_columns(r: wp.array2d(dtype=wp.float64), scale: wp.array(dtype=wp.float64),
+                    lower: wp.array(dtype=wp.float64), inv_denom: wp.array2d(dtype=wp.float64),
+                    cprime: wp.array2d(dtype=wp.float64),
+                    block: int, row0: int):
+    """Thomas algorithm along the rows (y) of ``r`` for a block of columns, in place.
+
+    Column k solves lower[j] x[j-1] + d[j, k] x[j] + upper[j, k] x[j+1] = scale[j] r[j, k] with the
+    factorisation precomputed (``cprime`` = upper / denom, ``inv_denom`` = 1 / denom); thread index
+    b (+ ``row0``, the launcher's chunk offset) owns columns [b block, (b+1) block), so that each
+    row of a block is a contiguous inner loop (WARP_CPU.md: row loops, no 2D tid)."""
+    b = row0 + wp.tid()
+    ny = r.shape[0]
+    k0 = b * block
+    k1 = wp.min(k0 + block, r.shape[1])
+    for k in range(k0, k1):
+        r[0, k] = scale[0] * r[0, k] * inv_denom[0, k]
+    for j in range(1, ny):
+        lo = lower[j]
+        sj = scale[j]
+        for k in range(k0, k1):
+            r[j, k] = (sj * r[j, k] - lo * r[j - 1, k]) * inv_denom[j, k]
+    for jj in range(1, ny):
+        j = ny - 1 - jj
+        for k in range(k0, k1):
+            r[j, k] = r[j, k] - cprime[j, k] * r[j + 1, k]

@@ -101,7 +101,7 @@ class Simulation:
         dev = self.L.device
         g, nx, ny = GHOST, grid.nx, grid.ny
         self.bc = BoundaryOperator(config.bc, grid, self.L)
-        self.poisson = poisson if poisson is not None else PoissonSolver(grid)
+        self.poisson = poisson if poisson is not None else PoissonSolver(grid, launcher=self.L)
         self.scheme = scheme_code(config.advection)
         self.stages = TIME_SCHEMES[config.time_scheme]
         self.bodies = list(bodies)
