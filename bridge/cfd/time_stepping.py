@@ -239,9 +239,7 @@ class Simulation:
             body.reset_impulse()
         src_u, src_v = self.u, self.v
         n = len(self.stages)
-
-        def compensation(c):  # forced faces pre-compensated by c G p ("full" form only; see immersed.py)
-            return (self.p, c) if self.config.pressure == "full" else (None, 0.0)
+        p_comp = self.p if self.config.pressure == "full" else None  # forcing compensation (immersed.py)
 
         for k, (a, b) in enumerate(self.stages):
             last = k == n - 1
@@ -249,7 +247,7 @@ class Simulation:
             self._predict(src_u, src_v, self.u, self.v, dt, a, b)
             self.bc.set_normal_faces(self.u, src_u, self.u_star, t_new, dt, a, b)
             for body in self.bodies:
-                body.apply(self.u_star, self.v_star, k, *compensation(b * dt))
+                body.apply(self.u_star, self.v_star, k, p_comp, b * dt)
             self._project(dst_u, dst_v, b * dt)
             self.bc.fill_ghosts(dst_u, dst_v)
             src_u, src_v = dst_u, dst_v

@@ -1,6 +1,9 @@
 """Small builders shared by the CFD tests (module name unique across test folders: the tests
 import it by name) and the devices to run kernel tests on (cuda only when present)."""
 
+import importlib.util
+from pathlib import Path
+
 import numpy as np
 import pytest
 import warp as wp
@@ -46,3 +49,12 @@ def advance(sim, t_end, cfl_dt):
 
 def loglog_slope(h, err):
     return float(np.polyfit(np.log(h), np.log(err), 1)[0])
+
+
+def load_tool(name: str):
+    """Import tools/<name>.py (the tools folder is not a package)."""
+    path = Path(__file__).resolve().parents[2] / "tools" / f"{name}.py"
+    spec = importlib.util.spec_from_file_location(name, path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod

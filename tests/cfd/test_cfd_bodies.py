@@ -3,7 +3,7 @@ symmetric drag, an accelerating body feels the added mass of potential theory (V
 
 import numpy as np
 import pytest
-from cfd_helpers import SLIP_BOX
+from cfd_helpers import SLIP_BOX, load_tool
 
 from bridge.cfd import (
     CartesianGrid,
@@ -137,13 +137,6 @@ def test_dfg_pressure_difference_at_d16():
     pressure: before the forced faces were compensated for the projection the difference was 0.141
     (+20 %) on every grid, with c_D within 2 %. Measured now: 0.1160 (-1.3 %), c_D 5.632 (+0.9 %).
     Tolerances 3 % and 2 %: the D/16 discretisation error, not a fit (D/32: 0.1174, 5.594)."""
-    import importlib.util
-    from pathlib import Path
-
-    path = Path(__file__).resolve().parents[2] / "tools" / "validate_cfd.py"
-    spec = importlib.util.spec_from_file_location("validate_cfd", path)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    res = mod.dfg(16, 4.0, 2, "vanleer")
+    res = load_tool("validate_cfd").dfg(16, 4.0, 2, "vanleer")
     assert abs(res["dp"] / 0.11752 - 1) < 0.03, res["dp"]
     assert abs(res["c_D"] / 5.5795 - 1) < 0.02, res["c_D"]

@@ -1,24 +1,14 @@
 """The CFD tools run end to end with tiny options (speed is not asserted: benchmarks are separate)."""
 
-import importlib.util
 import json
-from pathlib import Path
 
 import numpy as np
-
-ROOT = Path(__file__).resolve().parents[2]
-
-
-def _load(name):
-    spec = importlib.util.spec_from_file_location(name, ROOT / "tools" / f"{name}.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+from cfd_helpers import load_tool
 
 
 def test_bench_cfd_runs_tiny(tmp_path):
     out = tmp_path / "bench.json"
-    res = _load("bench_cfd").main(["--sizes", "32x16", "--repeats", "1", "--steps", "1", "--numpy-steps", "1",
+    res = load_tool("bench_cfd").main(["--sizes", "32x16", "--repeats", "1", "--steps", "1", "--numpy-steps", "1",
                                    "--bandwidth-mb", "8", "--json", str(out)])
     row = res["sizes"]["32x16"]
     assert row["warp"]["step"] > 0 and row["numpy_step"] > 0
@@ -27,8 +17,9 @@ def test_bench_cfd_runs_tiny(tmp_path):
 
 def test_validate_cfd_runs_tiny(tmp_path):
     out = tmp_path / "v.jsonl"
-    (res,) = _load("validate_cfd").main(["dfg", "--ppd", "6", "--t-end", "0.05", "--out", str(out)])
+    (res,) = load_tool("validate_cfd").main(["dfg", "--ppd", "6", "--t-end", "0.05", "--out", str(out)])
     assert np.isfinite(res["c_D"]) and res["cells"] == 132 * 25  # 2.2 x 0.41 at h = 0.1/6
-    (res,) = _load("validate_cfd").main(["cylinder", "--re", "20", "--ppd", "4", "--t-end", "0.1", "--out", str(out)])
+    (res,) = load_tool("validate_cfd").main(["cylinder", "--re", "20", "--ppd", "4", "--t-end", "0.1",
+                                             "--out", str(out)])
     assert np.isfinite(res["C_D"])
     assert len(out.read_text().splitlines()) == 2
