@@ -63,14 +63,13 @@ def upwind_flux(vel: wp.float64, q_m2: wp.float64, q_m1: wp.float64, q_p1: wp.fl
     return vel * q
 
 
-@wp.kernel
-def yflux_u(u: wp.array2d(dtype=wp.float64), v: wp.array2d(dtype=wp.float64),
-            nu: wp.array2d(dtype=wp.float64), hy_c: wp.array(dtype=wp.float64),
-            hy_f: wp.array(dtype=wp.float64), dx: wp.float64, i_lo: int, i_hi: int, row0: int, scheme: int,
-            flux: wp.array2d(dtype=wp.float64)):
-    """y-flux of x-momentum (advective - viscous) at the corners of v-face row J, u columns I:
-    computed once per corner and shared by the u-faces above and below (``predict_u``)."""
-    J = row0 + wp.tid()
+@wp.func
+def yflux_u_row(u: wp.array2d(dtype=wp.float64), v: wp.array2d(dtype=wp.float64),
+                nu: wp.array2d(dtype=wp.float64), hy_c: wp.array(dtype=wp.float64),
+                hy_f: wp.array(dtype=wp.float64), dx: wp.float64, J: int, i_lo: int, i_hi: int, scheme: int,
+                flux: wp.array2d(dtype=wp.float64), frow: int):
+    """y-flux of x-momentum (advective - viscous) at the corners of v-face row J, u columns I, into
+    ``flux[frow, I]``: computed once per corner and shared by the u-faces above and below."""
     half = wp.float64(0.5)
     one = wp.float64(1.0)
     ihf = one / hy_f[J]
@@ -81,57 +80,75 @@ def yflux_u(u: wp.array2d(dtype=wp.float64), v: wp.array2d(dtype=wp.float64),
     for I in range(i_lo, i_hi):
         vc = half * (v[J, I - 1] + v[J, I])
         nuc = wp.float64(0.25) * (nu[J - 1, I - 1] + nu[J - 1, I] + nu[J, I - 1] + nu[J, I])
-        flux[J, I] = upwind_flux(vc, u[J - 2, I], u[J - 1, I], u[J, I], u[J + 1, I], rm, rp, w, scheme) \
+        flux[frow, I] = upwind_flux(vc, u[J - 2, I], u[J - 1, I], u[J, I], u[J + 1, I], rm, rp, w, scheme) \
             - nuc * ((u[J, I] - u[J - 1, I]) * ihf + (v[J, I] - v[J, I - 1]) * idx)
 
 
-@wp.kernel
-def predict_u(u: wp.array2d(dtype=wp.float64), v: wp.array2d(dtype=wp.float64),
-              p: wp.array2d(dtype=wp.float64), nu: wp.array2d(dtype=wp.float64),
-              u0: wp.array2d(dtype=wp.float64), out: wp.array2d(dtype=wp.float64),
-              hy_c: wp.array(dtype=wp.float64), gflux: wp.array2d(dtype=wp.float64),
-              dx: wp.float64, dt: wp.float64, a: wp.float64, b: wp.float64,
-              i_lo: int, i_hi: int, row0: int, scheme: int):
-    """out = a*u0 + b*(u + dt*(-div(u u) + div(2 nu S)_x - dp/dx)) on u-faces of one row.
-
-    Conservative advection (limited upwind-biased) and the full variable-viscosity stress
-    nu (grad u + grad u^T) so an eddy viscosity nu_t(x, y) plugs in through ``nu``. The x-flux is
-    carried along the row; the y-fluxes come from ``yflux_u`` (rows J and J+1 of ``gflux``).
-    """
-    J = row0 + wp.tid()
-    half = wp.float64(0.5)
-    one = wp.float64(1.0)
-    two = wp.float64(2.0)
-    idx = one / dx
-    ihc = one / hy_c[J]
-    I = i_lo
-    uc = half * (u[J, I - 1] + u[J, I])
-    fl = upwind_flux(uc, u[J, I - 2], u[J, I - 1], u[J, I], u[J, I + 1], one, one, half, scheme) \
-        - two * nu[J, I - 1] * (u[J, I] - u[J, I - 1]) * idx
-    for I in range(i_lo, i_hi):
-        uc = half * (u[J, I] + u[J, I + 1])
-        fr = upwind_flux(uc, u[J, I - 1], u[J, I], u[J, I + 1], u[J, I + 2], one, one, half, scheme) \
-            - two * nu[J, I] * (u[J, I + 1] - u[J, I]) * idx
-        rhs = -(fr - fl) * idx - (gflux[J + 1, I] - gflux[J, I]) * ihc - (p[J, I] - p[J, I - 1]) * idx
-        out[J, I] = a * u0[J, I] + b * (u[J, I] + dt * rhs)
-        fl = fr
-
-
-@wp.kernel
-def yflux_v(v: wp.array2d(dtype=wp.float64), nu: wp.array2d(dtype=wp.float64),
-            hy_c: wp.array(dtype=wp.float64), i_lo: int, i_hi: int, row0: int, scheme: int,
-            flux: wp.array2d(dtype=wp.float64)):
-    """y-flux of y-momentum (advective - viscous) at the cell centres of row J, shared by the
-    v-faces J and J+1 (``predict_v``)."""
-    J = row0 + wp.tid()
+@wp.func
+def yflux_v_row(v: wp.array2d(dtype=wp.float64), nu: wp.array2d(dtype=wp.float64),
+                hy_c: wp.array(dtype=wp.float64), J: int, i_lo: int, i_hi: int, scheme: int,
+                flux: wp.array2d(dtype=wp.float64), frow: int):
+    """y-flux of y-momentum (advective - viscous) at the cell centres of row J into ``flux[frow, I]``,
+    shared by the v-faces J and J+1."""
     half = wp.float64(0.5)
     ihc = wp.float64(1.0) / hy_c[J]
     rm = hy_c[J] / hy_c[J - 1]
     rp = hy_c[J] / hy_c[J + 1]
     for I in range(i_lo, i_hi):
         vc = half * (v[J, I] + v[J + 1, I])
-        flux[J, I] = upwind_flux(vc, v[J - 1, I], v[J, I], v[J + 1, I], v[J + 2, I], rm, rp, half, scheme) \
+        flux[frow, I] = upwind_flux(vc, v[J - 1, I], v[J, I], v[J + 1, I], v[J + 2, I], rm, rp, half, scheme) \
             - wp.float64(2.0) * nu[J, I] * (v[J + 1, I] - v[J, I]) * ihc
+
+
+@wp.func
+def block_rows(b: int, n_blocks: int, j_start: int, n_rows: int):
+    """First and one-past-last row of block b when n_rows rows from j_start are cut into n_blocks."""
+    return j_start + (n_rows * b) // n_blocks, j_start + (n_rows * (b + 1)) // n_blocks
+
+
+@wp.kernel
+def predict_u(u: wp.array2d(dtype=wp.float64), v: wp.array2d(dtype=wp.float64),
+              p: wp.array2d(dtype=wp.float64), nu: wp.array2d(dtype=wp.float64),
+              u0: wp.array2d(dtype=wp.float64), out: wp.array2d(dtype=wp.float64),
+              hy_c: wp.array(dtype=wp.float64), hy_f: wp.array(dtype=wp.float64),
+              dx: wp.float64, dt: wp.float64, a: wp.float64, b: wp.float64,
+              i_lo: int, i_hi: int, j_start: int, n_rows: int, n_blocks: int, use_p: int, scheme: int,
+              block0: int, scratch: wp.array2d(dtype=wp.float64)):
+    """out = a*u0 + b*(u + dt*(-div(u u) + div(2 nu S)_x [- dp/dx])) on the u-faces of a block of rows.
+
+    Conservative advection (limited upwind-biased) and the full variable-viscosity stress
+    nu (grad u + grad u^T) so an eddy viscosity nu_t(x, y) plugs in through ``nu``; the pressure
+    gradient only when ``use_p`` (incremental form). Thread index + ``block0`` = block number: the
+    block's rows run bottom to top; the y-flux row above each row (``yflux_u_row``) goes to one of the
+    block's two ``scratch`` rows and serves as the row below for the next row (computed once, read
+    from cache); the x-flux is carried along the row.
+    """
+    blk = block0 + wp.tid()
+    r0, r1 = block_rows(blk, n_blocks, j_start, n_rows)
+    half = wp.float64(0.5)
+    one = wp.float64(1.0)
+    two = wp.float64(2.0)
+    idx = one / dx
+    s = 2 * blk
+    yflux_u_row(u, v, nu, hy_c, hy_f, dx, r0, i_lo, i_hi, scheme, scratch, s)
+    for J in range(r0, r1):
+        lo = s + (J - r0) % 2
+        hi = s + (J - r0 + 1) % 2
+        yflux_u_row(u, v, nu, hy_c, hy_f, dx, J + 1, i_lo, i_hi, scheme, scratch, hi)
+        ihc = one / hy_c[J]
+        I = i_lo
+        uc = half * (u[J, I - 1] + u[J, I])
+        fl = upwind_flux(uc, u[J, I - 2], u[J, I - 1], u[J, I], u[J, I + 1], one, one, half, scheme) \
+            - two * nu[J, I - 1] * (u[J, I] - u[J, I - 1]) * idx
+        for I in range(i_lo, i_hi):
+            uc = half * (u[J, I] + u[J, I + 1])
+            fr = upwind_flux(uc, u[J, I - 1], u[J, I], u[J, I + 1], u[J, I + 2], one, one, half, scheme) \
+                - two * nu[J, I] * (u[J, I + 1] - u[J, I]) * idx
+            rhs = -(fr - fl) * idx - (scratch[hi, I] - scratch[lo, I]) * ihc
+            if use_p != 0:
+                rhs -= (p[J, I] - p[J, I - 1]) * idx
+            out[J, I] = a * u0[J, I] + b * (u[J, I] + dt * rhs)
+            fl = fr
 
 
 @wp.kernel
@@ -139,33 +156,43 @@ def predict_v(u: wp.array2d(dtype=wp.float64), v: wp.array2d(dtype=wp.float64),
               p: wp.array2d(dtype=wp.float64), nu: wp.array2d(dtype=wp.float64),
               v0: wp.array2d(dtype=wp.float64), out: wp.array2d(dtype=wp.float64),
               hy_c: wp.array(dtype=wp.float64), hy_f: wp.array(dtype=wp.float64),
-              gflux: wp.array2d(dtype=wp.float64),
               dx: wp.float64, dt: wp.float64, a: wp.float64, b: wp.float64,
-              i_lo: int, i_hi: int, row0: int, scheme: int):
-    """out = a*v0 + b*(v + dt*(-div(v u) + div(2 nu S)_y - dp/dy)) on v-faces of one row
-    (x-flux carried along the row, y-fluxes from ``yflux_v`` rows J-1 and J)."""
-    J = row0 + wp.tid()
+              i_lo: int, i_hi: int, j_start: int, n_rows: int, n_blocks: int, use_p: int, scheme: int,
+              block0: int, scratch: wp.array2d(dtype=wp.float64)):
+    """out = a*v0 + b*(v + dt*(-div(v u) + div(2 nu S)_y [- dp/dy])) on the v-faces of a block of rows
+    (blocks, scratch rows and ``use_p`` as in ``predict_u``; the y-fluxes at the cell centres below
+    and above face row J come from ``yflux_v_row`` rows J-1 and J; x-flux carried along the row)."""
+    blk = block0 + wp.tid()
+    r0, r1 = block_rows(blk, n_blocks, j_start, n_rows)
     half = wp.float64(0.5)
     one = wp.float64(1.0)
     quarter = wp.float64(0.25)
     idx = one / dx
-    ihf = one / hy_f[J]
-    # weights of u rows J-1 and J at the corner height (face row J)
-    wl = half * hy_c[J] * ihf
-    wu = half * hy_c[J - 1] * ihf
-    I = i_lo
-    ucl = wl * u[J - 1, I] + wu * u[J, I]
-    nul = quarter * (nu[J - 1, I - 1] + nu[J - 1, I] + nu[J, I - 1] + nu[J, I])
-    fl = upwind_flux(ucl, v[J, I - 2], v[J, I - 1], v[J, I], v[J, I + 1], one, one, half, scheme) \
-        - nul * ((v[J, I] - v[J, I - 1]) * idx + (u[J, I] - u[J - 1, I]) * ihf)
-    for I in range(i_lo, i_hi):
-        ucr = wl * u[J - 1, I + 1] + wu * u[J, I + 1]
-        nur = quarter * (nu[J - 1, I] + nu[J - 1, I + 1] + nu[J, I] + nu[J, I + 1])
-        fr = upwind_flux(ucr, v[J, I - 1], v[J, I], v[J, I + 1], v[J, I + 2], one, one, half, scheme) \
-            - nur * ((v[J, I + 1] - v[J, I]) * idx + (u[J, I + 1] - u[J - 1, I + 1]) * ihf)
-        rhs = -(fr - fl) * idx - (gflux[J, I] - gflux[J - 1, I]) * ihf - (p[J, I] - p[J - 1, I]) * ihf
-        out[J, I] = a * v0[J, I] + b * (v[J, I] + dt * rhs)
-        fl = fr
+    s = 2 * blk
+    yflux_v_row(v, nu, hy_c, r0 - 1, i_lo, i_hi, scheme, scratch, s)
+    for J in range(r0, r1):
+        lo = s + (J - r0) % 2
+        hi = s + (J - r0 + 1) % 2
+        yflux_v_row(v, nu, hy_c, J, i_lo, i_hi, scheme, scratch, hi)
+        ihf = one / hy_f[J]
+        # weights of u rows J-1 and J at the corner height (face row J)
+        wl = half * hy_c[J] * ihf
+        wu = half * hy_c[J - 1] * ihf
+        I = i_lo
+        ucl = wl * u[J - 1, I] + wu * u[J, I]
+        nul = quarter * (nu[J - 1, I - 1] + nu[J - 1, I] + nu[J, I - 1] + nu[J, I])
+        fl = upwind_flux(ucl, v[J, I - 2], v[J, I - 1], v[J, I], v[J, I + 1], one, one, half, scheme) \
+            - nul * ((v[J, I] - v[J, I - 1]) * idx + (u[J, I] - u[J - 1, I]) * ihf)
+        for I in range(i_lo, i_hi):
+            ucr = wl * u[J - 1, I + 1] + wu * u[J, I + 1]
+            nur = quarter * (nu[J - 1, I] + nu[J - 1, I + 1] + nu[J, I] + nu[J, I + 1])
+            fr = upwind_flux(ucr, v[J, I - 1], v[J, I], v[J, I + 1], v[J, I + 2], one, one, half, scheme) \
+                - nur * ((v[J, I + 1] - v[J, I]) * idx + (u[J, I + 1] - u[J - 1, I + 1]) * ihf)
+            rhs = -(fr - fl) * idx - (scratch[hi, I] - scratch[lo, I]) * ihf
+            if use_p != 0:
+                rhs -= (p[J, I] - p[J - 1, I]) * ihf
+            out[J, I] = a * v0[J, I] + b * (v[J, I] + dt * rhs)
+            fl = fr
 
 
 @wp.kernel
@@ -364,6 +391,15 @@ def rigid_velocity(x: wp.float64, y: wp.float64, pos: wp.vec3d, vel: wp.vec3d, c
     return vel[1] + vel[2] * (x - pos[0])
 
 
+@wp.func
+def face_gradient(p: wp.array2d(dtype=wp.float64), hy_f: wp.array(dtype=wp.float64), dx: wp.float64,
+                  comp: int, J: int, I: int):
+    """(grad p) on the u-face (comp 0) or v-face (comp 1) stored at (J, I)."""
+    if comp == 0:
+        return (p[J, I] - p[J, I - 1]) / dx
+    return (p[J, I] - p[J - 1, I]) / hy_f[J]
+
+
 @wp.kernel
 def ib_targets(q: wp.array2d(dtype=wp.float64), phi: wp.array2d(dtype=wp.float64),
                x0: wp.float64, dx: wp.float64, xoff: wp.float64, yc: wp.array(dtype=wp.float64),
@@ -461,10 +497,7 @@ def ib_apply(q: wp.array2d(dtype=wp.float64), target: wp.array2d(dtype=wp.float6
             I = i0 + ib
             tq = target[jb, ib]
             if compensate != 0:
-                if comp == 0:
-                    tq += cgrad * (p[J, I] - p[J, I - 1]) / dx
-                else:
-                    tq += cgrad * (p[J, I] - p[J - 1, I]) / hy_f[J]
+                tq += cgrad * face_gradient(p, hy_f, dx, comp, J, I)
             dq = (tq - q[J, I]) * dx * hy[J]
             q[J, I] = tq
             mom += dq

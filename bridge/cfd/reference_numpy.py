@@ -76,7 +76,8 @@ class NumpyFlow:
     def _predict(self, u, v, u0, v0, us, vs, dt, a, b):
         g, nx, ny = GHOST, self.grid.nx, self.grid.ny
         dx, s, nu, hc, hf = self.grid.dx, self.scheme, self.nu, self.hc, self.hf
-        p = self.p if self.config.pressure == "incremental" else np.zeros_like(self.p)
+        inc = self.config.pressure == "incremental"  # the "full" form has no pressure in the predictor
+        p = self.p
         # u-faces: rows g..g+ny-1, columns g+1..g+nx-1
         J0, J1, I0, I1 = g, g + ny, g + 1, g + nx
 
@@ -98,7 +99,9 @@ class NumpyFlow:
                          H(hf, sh - 1), H(hf, sh), H(hf, sh + 1), 0.5 * H(hc, sh - 1) / H(hf, sh), s) \
                 - nut * ((A(u, sh, 0) - A(u, sh - 1, 0)) / H(hf, sh) + (A(v, sh, 0) - A(v, sh, -1)) / dx)
 
-        rhs = -(fx(0) - fx(-1)) / dx - (gy(1) - gy(0)) / H(hc, 0) - (A(p, 0, 0) - A(p, 0, -1)) / dx
+        rhs = -(fx(0) - fx(-1)) / dx - (gy(1) - gy(0)) / H(hc, 0)
+        if inc:
+            rhs -= (A(p, 0, 0) - A(p, 0, -1)) / dx
         us[J0:J1, I0:I1] = a * A(u0, 0, 0) + b * (A(u, 0, 0) + dt * rhs)
 
         # v-faces: rows g+1..g+ny-1, columns g..g+nx-1
@@ -118,7 +121,9 @@ class NumpyFlow:
                          H(hc, sh - 1), H(hc, sh), H(hc, sh + 1), 0.5, s) \
                 - 2 * A(nu, sh, 0) * (A(v, sh + 1, 0) - A(v, sh, 0)) / H(hc, sh)
 
-        rhs = -(fxv(1) - fxv(0)) / dx - (gyv(0) - gyv(-1)) / H(hf, 0) - (A(p, 0, 0) - A(p, -1, 0)) / H(hf, 0)
+        rhs = -(fxv(1) - fxv(0)) / dx - (gyv(0) - gyv(-1)) / H(hf, 0)
+        if inc:
+            rhs -= (A(p, 0, 0) - A(p, -1, 0)) / H(hf, 0)
         vs[J0:J1, I0:I1] = a * A(v0, 0, 0) + b * (A(v, 0, 0) + dt * rhs)
 
     def _boundary(self, u0, u, us, dt, a, b):

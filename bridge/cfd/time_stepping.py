@@ -18,7 +18,7 @@ State arrays are preallocated and mutated in place: stage 1 writes the stage buf
 stage overwrites the state (u); ``u_star`` is scratch. Ghosts are refreshed after every projection.
 
 Parts are swappable: the grid (object with metrics), the advection scheme (registry), the Poisson
-solver (any object with ``solve(rhs, out)``), the bodies (objects with ``update/apply/force``),
+solver (any object with ``solve_inplace(buf)`` and ``solve(rhs)``), the bodies (objects with ``update/apply/force``),
 ``nu`` (field), and the time scheme (registry of Shu-Osher coefficients).
 """
 
@@ -113,15 +113,16 @@ class Simulation:
         self.u, self.v, self.p = z(ushape), z(vshape), z(pshape)
         self.u_stage, self.v_stage = z(ushape), z(vshape)
         self.u_star, self.v_star = z(ushape), z(vshape)
-        self._flux_u, self._flux_v = z((ny + 1 + 2 * g, nx + 1 + 2 * g)), z(pshape)  # shared y-fluxes
-        self._p_zero = z(pshape) if config.pressure == "full" else None
+        # predictor row blocks: one per CPU thread (the y-flux carried up the block), short blocks on CUDA
+        self.n_blocks = self.L.threads if dev.is_cpu else max(1, ny // 4)
+        self._scratch = z((2 * self.n_blocks, nx + 1 + 2 * g))  # two y-flux rows per block
         self.nu = wp.full(pshape, config.nu, dtype=WP_DTYPE, device=dev)
-        self.rhs, self.phi = z((ny, nx)), z((ny, nx))
+        self.rhs = z((ny, nx))  # D u* / c, overwritten in place by phi (the Poisson solve)
         self.hy_c = wp.array(grid.hy_cells(), dtype=WP_DTYPE, device=dev)
         self.hy_f = wp.array(grid.hy_faces(), dtype=WP_DTYPE, device=dev)
         self._host = dev.is_cpu
         if self._host:  # zero-copy views for the FFT solve
-            self._rhs_np, self._phi_np = self.rhs.numpy(), self.phi.numpy()
+            self._rhs_np = self.rhs.numpy()
         self.t = 0.0
         self.n_steps = 0
         self.last_force = [np.zeros(3) for _ in self.bodies]
@@ -206,28 +207,25 @@ class Simulation:
     def _predict(self, src_u, src_v, u0, v0, dt, a, b):
         """Predicted u*, v* (interior faces) from the stage input (src) and the step start (u0, v0)."""
         g, nx, ny = GHOST, self.grid.nx, self.grid.ny
-        dx, s = self.grid.dx, self.scheme
-        p = self.p if self.config.pressure == "incremental" else self._p_zero
-        gu, gv = self._flux_u, self._flux_v
-        # y-fluxes once per corner / centre row, shared by the two faces they separate
-        self.L.rows(_k.yflux_u, ny + 1, g, [src_u, src_v, self.nu, self.hy_c, self.hy_f, dx, g + 1, g + nx,
-                                            ROW0, s, gu])
-        self.L.rows(_k.predict_u, ny, g, [src_u, src_v, p, self.nu, u0, self.u_star, self.hy_c, gu,
-                                          dx, dt, a, b, g + 1, g + nx, ROW0, s])
-        self.L.rows(_k.yflux_v, ny, g, [src_v, self.nu, self.hy_c, g, g + nx, ROW0, s, gv])
-        self.L.rows(_k.predict_v, ny - 1, g + 1, [src_u, src_v, p, self.nu, v0, self.v_star, self.hy_c,
-                                                  self.hy_f, gv, dx, dt, a, b, g, g + nx, ROW0, s])
+        dx, s, nb = self.grid.dx, self.scheme, self.n_blocks
+        use_p = int(self.config.pressure == "incremental")
+        common = [self.hy_c, self.hy_f, dx, dt, a, b]
+        self.L.rows(_k.predict_u, nb, 0, [src_u, src_v, self.p, self.nu, u0, self.u_star, *common,
+                                          g + 1, g + nx, g, ny, nb, use_p, s, ROW0, self._scratch], min_split=2)
+        self.L.rows(_k.predict_v, nb, 0, [src_u, src_v, self.p, self.nu, v0, self.v_star, *common,
+                                          g, g + nx, g + 1, ny - 1, nb, use_p, s, ROW0, self._scratch],
+                    min_split=2)
 
     def _project(self, dst_u, dst_v, c):
         g, nx, ny = GHOST, self.grid.nx, self.grid.ny
         self.L.rows(_k.divergence, ny, 0, [self.u_star, self.v_star, self.hy_c, self.grid.dx, 1.0 / c,
                                            g, nx, ROW0, self.rhs])
         if self._host:
-            self.poisson.solve(self._rhs_np, out=self._phi_np)
+            self.poisson.solve_inplace(self._rhs_np)
         else:
-            self.phi.assign(self.poisson.solve(self.rhs.numpy()))
+            self.rhs.assign(self.poisson.solve(self.rhs.numpy()))
         acc = int(self.config.pressure == "incremental")
-        self.L.rows(_k.project, ny, 0, [self.u_star, self.v_star, self.phi, self.hy_f, self.grid.dx, c,
+        self.L.rows(_k.project, ny, 0, [self.u_star, self.v_star, self.rhs, self.hy_f, self.grid.dx, c,
                                         g, nx, ny, acc, ROW0, dst_u, dst_v, self.p])
 
     def step(self, dt: float | None = None) -> float:
