@@ -106,6 +106,15 @@ class PoissonSolver:
         if not np.may_share_memory(r, buf):  # scipy may not transform in place: keep the contract
             np.copyto(buf, r)
 
+    def _wrap(self, buf: np.ndarray):
+        """Zero-copy Warp view of ``buf``, kept while the same buffer comes back (the time step
+        passes one buffer; a stable view lets the launcher replay its recorded launch)."""
+        key = (buf.ctypes.data, buf.shape)
+        if getattr(self, "_view_key", None) != key:
+            self._view = wp.array(buf, dtype=WP_DTYPE, device=self._launcher.device, copy=False)
+            self._view_key, self._view_base = key, buf  # keep buf alive while its view is cached
+        return self._view
+
     def solve_inplace(self, buf: np.ndarray) -> np.ndarray:
         """Overwrite the right-hand side ``buf`` ((ny, nx), C-contiguous float64) with phi; no
         allocation and no copy (the time step's path); returns ``buf``."""
@@ -119,7 +128,7 @@ class PoissonSolver:
             self._dct(buf, 0, inverse=True)
         elif self._launcher is not None:
             buf[0, 0] = 0.0
-            rw = wp.array(buf, dtype=WP_DTYPE, device=self._launcher.device, copy=False)
+            rw = self._wrap(buf)
             W = self._w
             self._launcher.rows(_k.tridiag_columns, self._blocks, 0,
                                 [rw, W["scale"], W["lower"], W["inv"], W["cp"], self._block, ROW0], min_split=2)

@@ -8,7 +8,7 @@ from cfd_helpers import DEVICES
 
 from bridge.cfd import CartesianGrid, FlowConfig, PoissonSolver, Simulation, circle, max_divergence, stretched_faces
 from bridge.cfd.advection import SCHEMES
-from bridge.cfd.launch import RowLauncher
+from bridge.cfd.launch import ROW0, RowLauncher
 from bridge.cfd.precision import DTYPE, WP_DTYPE
 from bridge.cfd.reference_numpy import NumpyFlow
 from kernels import cfd as kc
@@ -122,3 +122,25 @@ def test_set_viscosity_checks_shape_and_sign():
         sim.set_viscosity(np.zeros(grid.shape))
     with pytest.raises(ValueError, match="nu_eff"):
         sim.set_viscosity(np.ones((3, 3)))
+
+
+@wp.kernel
+def _scaled_rows(q: wp.array2d(dtype=wp.float64), value: wp.float64, row0: int):
+    J = row0 + wp.tid()
+    for I in range(q.shape[1]):
+        q[J, I] = value * wp.float64(J + 1)
+
+
+def test_recorded_launches_update_scalars_and_keep_row_chunks_apart():
+    """The launcher replays recorded launches: a changed float argument must reach the kernel, and
+    the two row chunks (same arrays, same size, run at the same time) must not share a record."""
+    launcher = RowLauncher("cpu", 2)
+    q = wp.zeros((8, 5), dtype=wp.float64, device="cpu")
+    expected_rows = np.arange(1, 9, dtype=float)[:, None] * np.ones((1, 5))
+    for value in (1.0, 2.5, 2.5, -3.0):
+        launcher.rows(_scaled_rows, 8, 0, [q, value, ROW0], min_split=2)
+        np.testing.assert_array_equal(q.numpy(), value * expected_rows)
+    plain = RowLauncher("cpu", 2, record=False)
+    r = wp.zeros((8, 5), dtype=wp.float64, device="cpu")
+    plain.rows(_scaled_rows, 8, 0, [r, -3.0, ROW0], min_split=2)
+    np.testing.assert_array_equal(r.numpy(), q.numpy())
