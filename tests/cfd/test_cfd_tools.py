@@ -11,7 +11,8 @@ def test_bench_cfd_runs_tiny(tmp_path):
     res = load_tool("bench_cfd").main(["--sizes", "32x16", "--repeats", "1", "--steps", "1", "--numpy-steps", "1",
                                    "--bandwidth-mb", "8", "--json", str(out)])
     row = res["sizes"]["32x16"]
-    assert row["warp"]["step"] > 0 and row["numpy_step"] > 0
+    assert row["steps"]["warp_step"] > 0 and row["steps"]["numpy_step"] > 0 and row["steps"]["speedup"] > 0
+    assert set(row["warp_parts"]) >= {"predict_u", "predict_v", "poisson", "project"}
     assert json.loads(out.read_text())["bytes_per_cell_step"] > 0
 
 
