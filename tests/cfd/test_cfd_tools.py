@@ -3,6 +3,7 @@
 import json
 
 import numpy as np
+import pytest
 from cfd_helpers import load_tool
 
 
@@ -24,3 +25,10 @@ def test_validate_cfd_runs_tiny(tmp_path):
                                              "--out", str(out)])
     assert np.isfinite(res["C_D"])
     assert len(out.read_text().splitlines()) == 2
+    # --ny-shift: one run per shift, the channel keeps its height with more (or fewer) cells across
+    shifted = load_tool("validate_cfd").main(["dfg", "--ppd", "6", "--t-end", "0.02", "--ny-shift", "-1", "2",
+                                              "--out", str(out)])
+    assert [r["ny"] for r in shifted] == [24, 27] and [r["ny_shift"] for r in shifted] == [-1, 2]
+    with pytest.raises(SystemExit):  # no cells left: refused before any run
+        load_tool("validate_cfd").main(["dfg", "--ppd", "6", "--ny-shift", "-25", "--out", str(out)])
+    assert len(out.read_text().splitlines()) == 4
