@@ -147,13 +147,21 @@ def _line_pressure(sim, x_target, side, y_line, body_phi, min_gap=0.5):
     return float(p1 + (p2 - p1) * (x_target - x1) / (x2 - x1))
 
 
+DFG_D, DFG_H = 0.1, 0.41  # cylinder diameter, channel height
+
+
+def dfg_cells_across(ppd):
+    """Cells across the DFG channel at h = D/ppd (before any ``ny_shift``)."""
+    return int(round(DFG_H / (DFG_D / ppd)))
+
+
 def dfg(ppd, t_end, threads, scheme, ib_order=1, ny_shift=0):
     """DFG 2D-1 on a uniform grid h = D/ppd; ``ny_shift`` adds cells across the channel (dy =
     0.41/(ny + ny_shift), nearly the same resolution, the cylinder cut differently by the grid)."""
-    d, h_ch, length, nu, umax = 0.1, 0.41, 2.2, 1e-3, 0.3
+    d, h_ch, length, nu, umax = DFG_D, DFG_H, 2.2, 1e-3, 0.3
     h = d / ppd
     nx = int(round(length / h))
-    ny = int(round(h_ch / h)) + ny_shift
+    ny = dfg_cells_across(ppd) + ny_shift
     grid = CartesianGrid.uniform(nx, ny, (0.0, length), (0.0, h_ch))
 
     def profile(y, t):
@@ -209,7 +217,7 @@ def main(argv=None):
     args = ap.parse_args(argv)
     wp.config.quiet = True
     command = "python tools/validate_cfd.py " + " ".join(argv if argv is not None else sys.argv[1:])
-    if args.case == "dfg" and any(k < 1 - round(0.41 / (0.1 / ppd)) for ppd in args.ppd for k in args.ny_shift):
+    if args.case == "dfg" and any(dfg_cells_across(ppd) + k < 1 for ppd in args.ppd for k in args.ny_shift):
         ap.error(f"--ny-shift: {args.ny_shift} leaves no cells across the channel")
     results = []
     for ppd in args.ppd:
