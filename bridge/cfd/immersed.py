@@ -141,6 +141,27 @@ class ImmersedBody:
                                                b["ni"], slot, p, self.hy_v, float(c),
                                                int(p is not None), self.acc])
 
+    def forced_cells(self) -> np.ndarray:
+        """Cells (ny, nx) with at least one face forced (inside the body or at its interface) by the
+        latest ``apply``. The pressure of such a cell is set by the forcing as much as by the flow (a
+        DFG probe on a cell with three forced faces read a pressure difference of 81 instead of 0.12),
+        so pressure probes use the other cells."""
+        g, nx, ny = GHOST, self.grid.nx, self.grid.ny
+        out = np.zeros((ny, nx), dtype=bool)
+        for comp, (dj, di) in ((0, (0, 1)), (1, (1, 0))):
+            b = self.boxes.get(comp)
+            if b is None:
+                continue
+            forced = np.zeros(self._storage_shape(comp), dtype=bool)
+            forced[b["j0"]:b["j0"] + b["nj"], b["i0"]:b["i0"] + b["ni"]] = b["state"].numpy() != 0
+            # the cell's two faces of this component: storage (J, I) and (J + dj, I + di)
+            out |= forced[g:g + ny, g:g + nx] | forced[g + dj:g + dj + ny, g + di:g + di + nx]
+        return out
+
+    def _storage_shape(self, comp):
+        g, nx, ny = GHOST, self.grid.nx, self.grid.ny
+        return (ny + 2 * g, nx + 1 + 2 * g) if comp == 0 else (ny + 1 + 2 * g, nx + 2 * g)
+
     def reset_impulse(self):
         self.acc.zero_()
 

@@ -135,8 +135,26 @@ def test_dfg_pressure_difference_at_d16():
     0.11752, c_D = 5.5795 on the cylinder in the channel, here at the coarse h = D/16 to t = 4 (the
     flow is steady by then to 1e-3). Checks that the pressure next to an immersed wall is the wall
     pressure: before the forced faces were compensated for the projection the difference was 0.141
-    (+20 %) on every grid, with c_D within 2 %. Measured now: 0.1160 (-1.3 %), c_D 5.632 (+0.9 %).
-    Tolerances 3 % and 2 %: the D/16 discretisation error, not a fit (D/32: 0.1174, 5.594)."""
+    (+20 %) on every grid, with c_D within 2 %. Measured now (pressure from the nearest cells without
+    forced faces, quadratic extrapolation): 0.1164 (-1.0 %), c_D 5.630 (+0.9 %). Tolerances 3 % and
+    2 %: the D/16 discretisation error, not a fit (D/32: 0.1171, 5.593)."""
     res = load_tool("validate_cfd").dfg(16, 4.0, 2, "vanleer")
     assert abs(res["dp"] / 0.11752 - 1) < 0.03, res["dp"]
     assert abs(res["c_D"] / 5.5795 - 1) < 0.02, res["c_D"]
+
+
+def test_forced_cells_are_the_cells_touching_forced_faces():
+    """``forced_cells`` (used to keep pressure probes off the forcing) marks every cell whose centre is
+    inside the body and the first ring outside it, and nothing more than about two cells away: the
+    forced faces are the faces inside the body and the first fluid face on each grid line."""
+    sim = _channel(Stationary(2.0, 0.1))
+    run(sim, 0.05, [])
+    forced = sim.bodies[0].forced_cells()
+    g = sim.grid
+    xc, yc = np.meshgrid(g.x_centres, g.y_centres)
+    dist = np.hypot(xc - 2.0, yc - 0.1) - 0.5
+    h = g.dx
+    assert forced.shape == (g.ny, g.nx)
+    assert forced[dist < 0.5 * h].all()
+    assert not forced[dist > 2.0 * h].any()
+    assert 0 < forced.sum() < forced.size
