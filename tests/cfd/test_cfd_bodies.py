@@ -4,6 +4,7 @@ symmetric drag, an accelerating body feels the added mass of potential theory (V
 import numpy as np
 import pytest
 from cfd_helpers import SLIP_BOX, load_tool
+from scipy.optimize import brentq
 
 from bridge.cfd import (
     CartesianGrid,
@@ -56,15 +57,17 @@ def test_body_at_rest_in_uniform_flow_symmetric_drag():
     assert 2.0 < cd < 6.0
 
 
-def _added_mass_coefficient(n):
+def _added_mass_coefficient(n, nu=0.02, steps_per_period=400):
+    """In-phase force coefficient of a cylinder x = A sin(w t), A = D/20, f = 1, in a closed 8D slip
+    box at rest, over the second period."""
     grid = CartesianGrid.uniform(8 * n, 8 * n, (-4.0, 4.0), (-4.0, 4.0))
-    amp, omega, nu = 0.05, 2 * np.pi, 1e-3
+    amp, omega = 0.05, 2 * np.pi
     sim = Simulation(grid, FlowConfig(nu=nu, bc=SLIP_BOX))
     sim.add_body(circle(1.0), HarmonicMotion(0.0, 0.0, (amp, 0.0, 0.0), omega))
     sim.set_state(u=0.0, v=0.0)
     h = ForceHistory()
-    dt = 1.0 / 200
-    for _ in range(400):
+    dt = 1.0 / steps_per_period
+    for _ in range(2 * steps_per_period):
         sim.step(dt)
         h(sim)
     t, f = h.array()
@@ -75,18 +78,32 @@ def _added_mass_coefficient(n):
     return a_sin / (np.pi / 4 * amp * omega ** 2)
 
 
-def test_added_mass_of_an_oscillating_cylinder():
-    """Cylinder oscillating in fluid at rest, x = A sin(w t), A = D/20, thin Stokes layer
-    (beta = D^2 f / nu = 1000): the force in phase with the acceleration is -C_m rho (pi D^2/4) a,
-    C_m = 1 from potential theory, about 1.07 with the Stokes-layer correction 4/sqrt(pi beta)
-    (Stokes 1851, Wang 1968) and a few per cent more for the 8D closed box: C_ref ~ 1.1.
-    Checks the forcing impulse and the internal-fluid correction together. Measured: C_m = 1.41 at
-    D/16 and 1.22 at D/32 (the Stokes layer, 0.02 D thick, is not resolved; error ~ first order
-    in h), so the test asserts the approach to C_ref, not a coarse-grid match."""
-    c_ref = 1.1
-    c16, c32 = _added_mass_coefficient(16), _added_mass_coefficient(32)
-    assert 1.0 < c32 < 1.3, c32
-    assert abs(c32 - c_ref) < 0.6 * abs(c16 - c_ref), (c16, c32)
+def test_added_mass_of_an_oscillating_cylinder_converges():
+    """Cylinder oscillating in fluid at rest with a resolved Stokes layer: beta = D^2 f/nu = 50,
+    delta = sqrt(2 nu/w) = 0.08 D (1.3 / 2.5 cells at D/16 / D/32). Stokes (1851) and Wang (1968,
+    J. Fluid Mech. 32): C_m = 1 + 4 (pi beta)^-1/2 + (pi beta)^-3/2 = 1.320 unbounded; the closed 8D
+    box adds about 3 % to the potential part ((R_o^2 + R^2)/(R_o^2 - R^2) = 1.032 for a circular
+    container of radius 4 D), so C_ref is about 1.35. Checks the forcing impulse and the internal-fluid
+    correction together, and how fast they converge. Measured: 1.534 / 1.445 / 1.409 at D/16 / 24 /
+    32, and 1.380 / 1.369 at D/48 / 64 with the same set-up (observed order 1.63 from 16/32/64,
+    extrapolated 1.350). Asserted from the three coarse grids (order 1.67, limit 1.352): the order and
+    the extrapolated limit against C_ref; limits 1.3 and 4 %, wider than the scatter of the measured
+    order between grid triples (1.59-1.66) and the uncertainty of the confinement estimate."""
+    n = np.array([16, 24, 32])
+    c = np.array([_added_mass_coefficient(k) for k in n])
+    # C(h) = C_inf + a h^p through three points: solve for p from the ratio of differences
+    ratio = (c[0] - c[1]) / (c[1] - c[2])
+
+    def mismatch(p):
+        hp = (1.0 / n) ** p
+        return (hp[0] - hp[1]) / (hp[1] - hp[2]) - ratio
+
+    p = brentq(mismatch, 0.2, 4.0)
+    hp = (1.0 / n) ** p
+    c_inf = c[2] - (c[1] - c[2]) * hp[2] / (hp[1] - hp[2])
+    assert np.all(np.diff(c) < 0), c  # approaches from above, monotonically
+    assert p > 1.3, (p, c)
+    assert abs(c_inf / 1.35 - 1) < 0.04, (c_inf, p, c)
 
 
 def test_nan_monitor_restores_last_good_state_and_stops():
