@@ -73,7 +73,7 @@ def _state_matrix(model: ModalModel, aero: AerodynamicModel, rho: float, w: floa
 
 def aeroelastic_eigenvalues(model: ModalModel, aero: AerodynamicModel, air_density: float, speed: float,
                             guesses: np.ndarray, shapes: np.ndarray | None = None, tolerance: float = 1e-10,
-                            max_iterations: int = 200, strict: bool = True
+                            max_iterations: int = 200, strict: bool = True, modes=None
                             ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """p-k eigenvalue s_r and modal shape (complex N-vector of modal amplitudes) of each mode at wind
     speed V, iterating on frequency from ``guesses`` (one per mode: the previous speed's eigenvalues, or
@@ -90,6 +90,8 @@ def aeroelastic_eigenvalues(model: ModalModel, aero: AerodynamicModel, air_densi
     eigenvalue is then not a p-k solution and the caller discards it).  With ``strict=False`` a mode whose
     iteration does not converge (the tracked eigenvalue jumps between branches, so Im s(w) = w has no
     root on it) is flagged the same way instead of raising ConvergenceError.
+    ``modes``: iterate only these mode indices (the others are returned as their guesses, unflagged):
+    refining one mode's damping crossing must not depend on, or fail for, another mode's iteration.
     """
     n = model.n_modes
     shapes = np.eye(n, dtype=np.complex128) if shapes is None else np.asarray(shapes, dtype=np.complex128)
@@ -102,6 +104,9 @@ def aeroelastic_eigenvalues(model: ModalModel, aero: AerodynamicModel, air_densi
     unresolved = np.zeros(n, dtype=bool)
     scale = np.sqrt(model.modal_masses)[:, None]   # shapes compared in mass-normalised coordinates
     for r, s_prev in enumerate(np.asarray(guesses, dtype=np.complex128)):
+        if modes is not None and r not in modes:
+            out[r], out_shapes[:, r] = s_prev, shapes[:, r]
+            continue
         ref = shapes[:, r] / np.linalg.norm(shapes[:, r])
 
         def track(w: float, ref=ref, s_prev=s_prev) -> tuple[complex, np.ndarray, float]:
@@ -229,14 +234,15 @@ def pk_sweep(model: ModalModel, aero: AerodynamicModel, air_density: float, max_
             break                                        # any later divergence is beyond flutter anyway
 
         def zeta_r(V: float, n0=n0, r=r) -> float:
-            s_all, _, off = aeroelastic_eigenvalues(model, aero, air_density, V, eig[n0], shapes[n0], tolerance)
+            s_all, _, off = aeroelastic_eigenvalues(model, aero, air_density, V, eig[n0], shapes[n0], tolerance,
+                                                    modes=(r,))
             if off[r]:
                 raise InputError("flutter.reduced_frequency", float(s_all[r].imag * model.deck_width_m / V),
                                  "outside the aerodynamic model's range while refining the p-k crossing")
             return float(_damping(s_all[r:r + 1])[0])
 
         V_c = brentq(zeta_r, speeds[n0], speeds[n0 + 1], xtol=1e-12 * speeds[n0 + 1], rtol=1e-12)
-        s_c = aeroelastic_eigenvalues(model, aero, air_density, V_c, eig[n0], shapes[n0], tolerance)[0][r]
+        s_c = aeroelastic_eigenvalues(model, aero, air_density, V_c, eig[n0], shapes[n0], tolerance, modes=(r,))[0][r]
         if s_c.imag < w_floor:                             # zero frequency: static divergence, not flutter
             divergence = float(V_c) if np.isnan(divergence) else divergence
         elif flutter_at is None:
