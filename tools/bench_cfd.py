@@ -164,10 +164,24 @@ def bandwidth(n_bytes=256 * 2**20, repeats=5):
     return statistics.median(copy) / 1e9, statistics.median(tri) / 1e9
 
 
+def _sizes(text: str) -> list[tuple[int, int]]:
+    """'NXxNY,NXxNY,...' -> [(nx, ny), ...], each at least 16 x 16."""
+    out = []
+    for size in text.split(","):
+        try:
+            nx, ny = (int(s) for s in size.lower().split("x"))
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{size!r} is not NXxNY (e.g. 1024x512)") from None
+        if nx < 16 or ny < 16:
+            raise argparse.ArgumentTypeError(f"{size}: allowed NX, NY >= 16")
+        out.append((nx, ny))
+    return out
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--sizes", default="256x128,512x256,1024x512")
+    ap.add_argument("--sizes", type=_sizes, default="256x128,512x256,1024x512")
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--steps", type=int, default=5, help="steps per timed block")
@@ -176,6 +190,9 @@ def main(argv=None):
     ap.add_argument("--json", default=None)
     ap.add_argument("--bandwidth-mb", type=int, default=256, help="array size of the bandwidth test")
     args = ap.parse_args(argv)
+    for name in ("threads", "repeats", "steps", "numpy_steps", "bandwidth_mb"):
+        if getattr(args, name) < 1:
+            ap.error(f"--{name.replace('_', '-')}: {getattr(args, name)} not allowed; allowed: >= 1")
     wp.config.quiet = True
     wp.init()
     copy_bw, triad_bw = bandwidth(args.bandwidth_mb * 2**20)
@@ -185,8 +202,8 @@ def main(argv=None):
           f"~{bytes_step} B per cell-step -> roofline {bw / bytes_step / 1e6:.1f} M cell-steps/s (triad)")
     results = {"bandwidth_GBs": {"memcpy": copy_bw, "triad_2threads": triad_bw},
                "bytes_per_cell_step": bytes_step, "sizes": {}}
-    for size in args.sizes.split(","):
-        nx, ny = (int(s) for s in size.lower().split("x"))
+    for nx, ny in args.sizes:
+        size = f"{nx}x{ny}"
         st, sim = bench_steps(nx, ny, args.threads, args.repeats, args.steps, args.numpy_steps, args.device)
         w = bench_warp(sim, args.repeats, args.steps, args.device)
         roof = bw / bytes_step

@@ -43,6 +43,7 @@ from bridge.cfd import (  # noqa: E402
     run,
     stretched_faces,
 )
+from bridge.cfd.advection import SCHEMES  # noqa: E402
 
 BANDS = {  # VALIDATION.md
     20: {"C_D": (2.00, 2.09), "L_w/D": (0.91, 0.94)},
@@ -212,7 +213,7 @@ def main(argv=None):
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--domain", type=float, nargs=3, default=[10.0, 20.0, 15.0],
                     metavar=("UPSTREAM", "DOWNSTREAM", "HALF_HEIGHT"), help="cylinder box in D")
-    ap.add_argument("--advection", default="vanleer")
+    ap.add_argument("--advection", default="vanleer", choices=sorted(SCHEMES))
     ap.add_argument("--ib-order", type=int, choices=[1, 2], default=1,
                     help="interpolation of the forced faces: 1 linear (Fadlun et al.), 2 quadratic")
     ap.add_argument("--ny-shift", type=int, nargs="+", default=[0],
@@ -222,13 +223,12 @@ def main(argv=None):
     args = ap.parse_args(argv)
     wp.config.quiet = True
     command = "python tools/validate_cfd.py " + " ".join(argv if argv is not None else sys.argv[1:])
-    if args.case == "dfg" and any(dfg_cells_across(ppd) + k < 1 for ppd in args.ppd for k in args.ny_shift):
-        ap.error(f"--ny-shift: {args.ny_shift} leaves no cells across the channel")
+    _check_args(ap, args)
     results = []
     for ppd in args.ppd:
         for shift in (args.ny_shift if args.case == "dfg" else [0]):
             if args.case == "cylinder":
-                r = cylinder(int(args.re), ppd, args.t_end, args.window, args.threads, args.advection,
+                r = cylinder(args.re, ppd, args.t_end, args.window, args.threads, args.advection,
                              *args.domain, ib_order=args.ib_order)
             else:
                 r = dfg(ppd, args.t_end, args.threads, args.advection, args.ib_order, shift)
@@ -236,6 +236,22 @@ def main(argv=None):
             _emit(r, args.out)
             results.append(r)
     return results
+
+
+def _check_args(ap, args):
+    """Refuse bad input before any run (argparse error: one line naming the option, exit 2)."""
+    checks = [("--ppd", args.ppd, min(args.ppd) >= 4, "cells per diameter >= 4 (the body must span cells)"),
+              ("--re", args.re, args.re > 0, "> 0"),
+              ("--t-end", args.t_end, args.t_end > 0, "> 0"),
+              ("--window", args.window, args.window > 0, "> 0"),
+              ("--threads", args.threads, args.threads >= 1, ">= 1"),
+              ("--domain", args.domain, min(args.domain[:2]) >= 1 and args.domain[2] > 1.5,
+               "UPSTREAM, DOWNSTREAM >= 1 D and HALF_HEIGHT > 1.5 D (the refined band is +-1.5 D)")]
+    for name, value, ok, allowed in checks:
+        if not ok:
+            ap.error(f"{name}: {value} not allowed; allowed: {allowed}")
+    if args.case == "dfg" and any(dfg_cells_across(ppd) + k < 1 for ppd in args.ppd for k in args.ny_shift):
+        ap.error(f"--ny-shift: {args.ny_shift} leaves no cells across the channel")
 
 
 def _emit(r, out):

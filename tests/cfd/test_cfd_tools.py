@@ -32,3 +32,32 @@ def test_validate_cfd_runs_tiny(tmp_path):
     with pytest.raises(SystemExit):  # no cells left: refused before any run
         load_tool("validate_cfd").main(["dfg", "--ppd", "6", "--ny-shift", "-25", "--out", str(out)])
     assert len(out.read_text().splitlines()) == 4
+
+
+@pytest.mark.parametrize("argv, option", [
+    (["dfg", "--ppd", "0"], "--ppd"),
+    (["cylinder", "--re", "-5"], "--re"),
+    (["dfg", "--t-end", "-1"], "--t-end"),
+    (["cylinder", "--window", "0"], "--window"),
+    (["dfg", "--threads", "0"], "--threads"),
+    (["cylinder", "--domain", "10", "20", "1"], "--domain"),
+    (["dfg", "--advection", "upwind"], "--advection"),
+])
+def test_validate_cfd_refuses_bad_input_naming_the_option(tmp_path, capsys, argv, option):
+    out = tmp_path / "v.jsonl"
+    with pytest.raises(SystemExit) as exc:
+        load_tool("validate_cfd").main([*argv, "--out", str(out)])
+    assert exc.value.code == 2
+    assert option in capsys.readouterr().err
+    assert not out.exists()  # nothing written
+
+
+@pytest.mark.parametrize("argv, option", [(["--sizes", "0x0"], "--sizes"), (["--sizes", "abc"], "--sizes"),
+                                          (["--repeats", "0"], "--repeats"), (["--steps", "0"], "--steps")])
+def test_bench_cfd_refuses_bad_input_naming_the_option(tmp_path, capsys, argv, option):
+    out = tmp_path / "b.json"
+    with pytest.raises(SystemExit) as exc:
+        load_tool("bench_cfd").main([*argv, "--json", str(out)])
+    assert exc.value.code == 2
+    assert option in capsys.readouterr().err
+    assert not out.exists()
