@@ -171,9 +171,9 @@ def _sizes(text: str) -> list[tuple[int, int]]:
         try:
             nx, ny = (int(s) for s in size.lower().split("x"))
         except ValueError:
-            raise argparse.ArgumentTypeError(f"{size!r} is not NXxNY (e.g. 1024x512)") from None
+            raise argparse.ArgumentTypeError(f"{size!r} not allowed; allowed: NXxNY, e.g. 1024x512") from None
         if nx < 16 or ny < 16:
-            raise argparse.ArgumentTypeError(f"{size}: allowed NX, NY >= 16")
+            raise argparse.ArgumentTypeError(f"{size} not allowed; allowed: NX, NY >= 16")
         out.append((nx, ny))
     return out
 

@@ -12,8 +12,9 @@ recirculation length L_w/D (last zero of u on the wake centreline, from the rear
 Strouhal number from the zero up-crossings of C_L over the last ``--window`` time units.
 DFG 2D-1 (Schaefer and Turek 1996): channel 2.2 x 0.41, D = 0.1 at (0.2, 0.2), nu = 1e-3, parabolic
 inflow U_max = 0.3, no-slip walls; c_D, c_L on U_mean = 0.2; pressure difference between the front
-and rear points of the cylinder, each linearly extrapolated from the two nearest fluid cells on
-the line y = 0.2. ``--ppd``: grid cells per diameter. Results are appended to ``--out`` as JSON lines.
+and rear points of the cylinder, each extrapolated along the line y = 0.2 from the nearest cells
+without forced faces: dp quadratically from three, dp_linear linearly from two. ``--ppd``: grid
+cells per diameter. Results are appended to ``--out`` as JSON lines.
 """
 
 from __future__ import annotations
@@ -102,7 +103,7 @@ def cylinder(re, ppd, t_end, window, threads, scheme, upstream=10.0, downstream=
     wall = time.perf_counter() - t0
     t, f = hist.array()
     cd, cl = 2 * f[:, 0, 0], 2 * f[:, 0, 1]
-    out = {"case": f"cylinder Re={re}", "ppd": ppd, "cells": grid.nx * grid.ny, "nx": grid.nx, "ny": grid.ny,
+    out = {"case": f"cylinder Re={re:g}", "ppd": ppd, "cells": grid.nx * grid.ny, "nx": grid.nx, "ny": grid.ny,
            "t_end": float(sim.t), "steps": sim.n_steps, "wall_s": wall, "blockage": 0.5 / half_height,
            "domain": [-upstream, downstream, -half_height, half_height],
            "advection": scheme}

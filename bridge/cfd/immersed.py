@@ -92,7 +92,7 @@ class ImmersedBody:
         yc = self._yc_u_np if comp == 0 else self._yc_v_np
         j0 = int(np.searchsorted(yc, yr - R)) - m
         j1 = int(np.searchsorted(yc, yr + R)) + m + 1
-        ncol = self.grid.nx + 1 + 2 * GHOST if comp == 0 else self.grid.nx + 2 * GHOST
+        ncol = self._storage_shape(comp)[1]
         i0, i1 = max(i0, 1), min(i1, ncol - 1)
         j0, j1 = max(j0, 1), min(j1, yc.size - 1)
         if i1 - i0 < 3 or j1 - j0 < 3:

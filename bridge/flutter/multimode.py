@@ -17,6 +17,7 @@ Lateral modes carry no aerodynamic FRF in the thesis's model and are left out.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -73,7 +74,8 @@ def _state_matrix(model: ModalModel, aero: AerodynamicModel, rho: float, w: floa
 
 def aeroelastic_eigenvalues(model: ModalModel, aero: AerodynamicModel, air_density: float, speed: float,
                             guesses: np.ndarray, shapes: np.ndarray | None = None, tolerance: float = 1e-10,
-                            max_iterations: int = 200, strict: bool = True, modes=None
+                            max_iterations: int = 200, strict: bool = True,
+                            modes: Sequence[int] | None = None
                             ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """p-k eigenvalue s_r and modal shape (complex N-vector of modal amplitudes) of each mode at wind
     speed V, iterating on frequency from ``guesses`` (one per mode: the previous speed's eigenvalues, or
@@ -90,8 +92,9 @@ def aeroelastic_eigenvalues(model: ModalModel, aero: AerodynamicModel, air_densi
     eigenvalue is then not a p-k solution and the caller discards it).  With ``strict=False`` a mode whose
     iteration does not converge (the tracked eigenvalue jumps between branches, so Im s(w) = w has no
     root on it) is flagged the same way instead of raising ConvergenceError.
-    ``modes``: iterate only these mode indices (the others are returned as their guesses, unflagged):
-    refining one mode's damping crossing must not depend on, or fail for, another mode's iteration.
+    ``modes``: iterate only these mode indices; the others come back as NaN and flagged, never as a
+    solution (refining one mode's damping crossing must not depend on, or fail for, another mode's
+    iteration).
     """
     n = model.n_modes
     shapes = np.eye(n, dtype=np.complex128) if shapes is None else np.asarray(shapes, dtype=np.complex128)
@@ -105,7 +108,7 @@ def aeroelastic_eigenvalues(model: ModalModel, aero: AerodynamicModel, air_densi
     scale = np.sqrt(model.modal_masses)[:, None]   # shapes compared in mass-normalised coordinates
     for r, s_prev in enumerate(np.asarray(guesses, dtype=np.complex128)):
         if modes is not None and r not in modes:
-            out[r], out_shapes[:, r] = s_prev, shapes[:, r]
+            out[r], out_shapes[:, r], outside[r] = np.nan, np.nan, True
             continue
         ref = shapes[:, r] / np.linalg.norm(shapes[:, r])
 

@@ -11,7 +11,7 @@ from conftest import RHO, plate_section, selberg_speed
 from bridge.flutter.aerodynamics import Theodorsen
 from bridge.flutter.determinant import solve_pair
 from bridge.flutter.modal import ModalModel
-from bridge.flutter.multimode import pk_sweep
+from bridge.flutter.multimode import aeroelastic_eigenvalues, pk_sweep
 
 
 @pytest.mark.parametrize("frequency_ratio, mass_ratio, radius_ratio, damping", [
@@ -81,6 +81,20 @@ def test_mode_tracking_through_close_frequencies(frequencies_hz):
     pk = pk_sweep(model, Theodorsen(), RHO, 150.0, n_speed=60)
     assert det.flutter and pk.flutter and pk.unstable_mode == "T1"
     assert abs(pk.critical_speed_m_s / det.critical_speed_m_s - 1) < 0.005
+
+
+def test_iterating_one_mode_gives_its_full_call_result_and_no_others():
+    """``modes=(r,)`` (used to refine one mode's damping crossing) returns mode r exactly as a call over
+    all modes does, and the skipped modes as NaN and flagged, never as a solution."""
+    model = ModalModel.from_two_modes(bending_frequency_hz=0.128, torsion_frequency_hz=0.294, a_jj=0.308,
+                                      a_kk=0.239, a_jk=0.038, mass_per_length_kg_m=21.5e3,
+                                      inertia_per_length_kg_m2_m=2.9e6, deck_width_m=31.0, deck_length_m=2694.0)
+    guesses = 1j * model.angular_frequencies
+    s_all, phi_all, off_all = aeroelastic_eigenvalues(model, Theodorsen(), RHO, 60.0, guesses, strict=False)
+    s_one, phi_one, off_one = aeroelastic_eigenvalues(model, Theodorsen(), RHO, 60.0, guesses, modes=(1,))
+    assert s_one[1] == s_all[1] and np.array_equal(phi_one[:, 1], phi_all[:, 1])
+    assert not off_one[1] and not off_all[1]
+    assert np.isnan(s_one[0]) and np.isnan(phi_one[:, 0]).all() and off_one[0]
 
 
 def test_static_divergence_of_a_torsional_mode_matches_the_closed_form():
