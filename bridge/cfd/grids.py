@@ -94,6 +94,14 @@ class CartesianGrid:
         return float(min(self.dx, self.dy.min()))
 
     # --- metrics in storage indexing (with ghosts, mirrored at the boundaries) ------------------
+    def storage_shape(self, field: str) -> tuple[int, int]:
+        """Storage shape (with ghosts) of ``field``: "u", "v" or "p" (module doc)."""
+        g, nx, ny = GHOST, self.nx, self.ny
+        shapes = {"u": (ny + 2 * g, nx + 1 + 2 * g), "v": (ny + 1 + 2 * g, nx + 2 * g), "p": (ny + 2 * g, nx + 2 * g)}
+        if field not in shapes:
+            raise ValueError(f"field: 'u', 'v' or 'p', got {field!r}")
+        return shapes[field]
+
     def storage_y_centres(self) -> np.ndarray:
         """y of cell-row centres for storage rows 0..ny+2G-1 (ghost rows mirrored)."""
         g = GHOST

@@ -92,7 +92,7 @@ class ImmersedBody:
         yc = self._yc_u_np if comp == 0 else self._yc_v_np
         j0 = int(np.searchsorted(yc, yr - R)) - m
         j1 = int(np.searchsorted(yc, yr + R)) + m + 1
-        ncol = self._storage_shape(comp)[1]
+        ncol = self.grid.storage_shape("uv"[comp])[1]
         i0, i1 = max(i0, 1), min(i1, ncol - 1)
         j0, j1 = max(j0, 1), min(j1, yc.size - 1)
         if i1 - i0 < 3 or j1 - j0 < 3:
@@ -152,15 +152,11 @@ class ImmersedBody:
             b = self.boxes.get(comp)
             if b is None:
                 continue
-            forced = np.zeros(self._storage_shape(comp), dtype=bool)
+            forced = np.zeros(self.grid.storage_shape("uv"[comp]), dtype=bool)
             forced[b["j0"]:b["j0"] + b["nj"], b["i0"]:b["i0"] + b["ni"]] = b["state"].numpy() != 0
             # the cell's two faces of this component: storage (J, I) and (J + dj, I + di)
             out |= forced[g:g + ny, g:g + nx] | forced[g + dj:g + dj + ny, g + di:g + di + nx]
         return out
-
-    def _storage_shape(self, comp):
-        g, nx, ny = GHOST, self.grid.nx, self.grid.ny
-        return (ny + 2 * g, nx + 1 + 2 * g) if comp == 0 else (ny + 1 + 2 * g, nx + 2 * g)
 
     def reset_impulse(self):
         self.acc.zero_()

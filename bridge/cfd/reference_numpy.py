@@ -46,10 +46,7 @@ class NumpyFlow:
         if not (bc.left == "inflow" and bc.bottom == "slip" and bc.top == "slip" and bc.inflow_profile is None):
             raise ValueError("bc: the NumPy reference implements uniform inflow, outflow and slip sides only")
         self.grid, self.config = grid, config
-        g, nx, ny = GHOST, grid.nx, grid.ny
-        self.u = np.zeros((ny + 2 * g, nx + 1 + 2 * g))
-        self.v = np.zeros((ny + 1 + 2 * g, nx + 2 * g))
-        self.p = np.zeros((ny + 2 * g, nx + 2 * g))
+        self.u, self.v, self.p = (np.zeros(grid.storage_shape(f)) for f in "uvp")
         self.nu = np.full_like(self.p, config.nu)
         self.hc = grid.hy_cells()
         self.hf = grid.hy_faces()

@@ -109,7 +109,7 @@ class Simulation:
         def z(shape):
             return wp.zeros(shape, dtype=WP_DTYPE, device=dev)
 
-        ushape, vshape, pshape = (ny + 2 * g, nx + 1 + 2 * g), (ny + 1 + 2 * g, nx + 2 * g), (ny + 2 * g, nx + 2 * g)
+        ushape, vshape, pshape = (grid.storage_shape(f) for f in "uvp")
         self.u, self.v, self.p = z(ushape), z(vshape), z(pshape)
         self.u_stage, self.v_stage = z(ushape), z(vshape)
         self.u_star, self.v_star = z(ushape), z(vshape)

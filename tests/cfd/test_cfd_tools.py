@@ -34,30 +34,24 @@ def test_validate_cfd_runs_tiny(tmp_path):
     assert len(out.read_text().splitlines()) == 4
 
 
-@pytest.mark.parametrize("argv, option", [
-    (["dfg", "--ppd", "0"], "--ppd"),
-    (["cylinder", "--re", "-5"], "--re"),
-    (["dfg", "--t-end", "-1"], "--t-end"),
-    (["cylinder", "--window", "0"], "--window"),
-    (["dfg", "--threads", "0"], "--threads"),
-    (["cylinder", "--domain", "10", "20", "1"], "--domain"),
-    (["dfg", "--advection", "upwind"], "--advection"),
+@pytest.mark.parametrize("tool, argv, option", [
+    ("validate_cfd", ["dfg", "--ppd", "0"], "--ppd"),
+    ("validate_cfd", ["cylinder", "--re", "-5"], "--re"),
+    ("validate_cfd", ["dfg", "--t-end", "-1"], "--t-end"),
+    ("validate_cfd", ["cylinder", "--window", "0"], "--window"),
+    ("validate_cfd", ["dfg", "--threads", "0"], "--threads"),
+    ("validate_cfd", ["cylinder", "--domain", "10", "20", "1"], "--domain"),
+    ("validate_cfd", ["dfg", "--advection", "upwind"], "--advection"),
+    ("bench_cfd", ["--sizes", "0x0"], "--sizes"),
+    ("bench_cfd", ["--sizes", "abc"], "--sizes"),
+    ("bench_cfd", ["--repeats", "0"], "--repeats"),
+    ("bench_cfd", ["--steps", "0"], "--steps"),
 ])
-def test_validate_cfd_refuses_bad_input_naming_the_option(tmp_path, capsys, argv, option):
-    out = tmp_path / "v.jsonl"
+def test_cfd_tools_refuse_bad_input_naming_the_option(tmp_path, capsys, tool, argv, option):
+    out = tmp_path / "result"
+    out_flag = "--out" if tool == "validate_cfd" else "--json"
     with pytest.raises(SystemExit) as exc:
-        load_tool("validate_cfd").main([*argv, "--out", str(out)])
+        load_tool(tool).main([*argv, out_flag, str(out)])
     assert exc.value.code == 2
     assert option in capsys.readouterr().err
     assert not out.exists()  # nothing written
-
-
-@pytest.mark.parametrize("argv, option", [(["--sizes", "0x0"], "--sizes"), (["--sizes", "abc"], "--sizes"),
-                                          (["--repeats", "0"], "--repeats"), (["--steps", "0"], "--steps")])
-def test_bench_cfd_refuses_bad_input_naming_the_option(tmp_path, capsys, argv, option):
-    out = tmp_path / "b.json"
-    with pytest.raises(SystemExit) as exc:
-        load_tool("bench_cfd").main([*argv, "--json", str(out)])
-    assert exc.value.code == 2
-    assert option in capsys.readouterr().err
-    assert not out.exists()
