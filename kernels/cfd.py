@@ -223,23 +223,43 @@ def project(ustar: wp.array2d(dtype=wp.float64), vstar: wp.array2d(dtype=wp.floa
     cy = c / hy_f[J]
     u[J, g] = ustar[J, g]
     u[J, g + nx] = ustar[J, g + nx]
+    jm = wp.max(j - 1, 0)  # the bottom row's v-faces are boundary faces: copied (cy = 0)
     if j == 0:
-        for i in range(nx):
-            v[J, i + g] = vstar[J, i + g]
-    else:
-        for i in range(nx):
-            v[J, i + g] = vstar[J, i + g] - cy * (phi[j, i] - phi[j - 1, i])
-    for i in range(1, nx):
-        u[J, i + g] = ustar[J, i + g] - cx * (phi[j, i] - phi[j, i - 1])
-    if accumulate != 0:
-        for i in range(nx):
-            p[J, i + g] = p[J, i + g] + phi[j, i]
-    else:
-        for i in range(nx):
-            p[J, i + g] = phi[j, i]
+        cy = wp.float64(0.0)
+    for i in range(nx):  # one pass over the row: v-face, u-face and pressure of each cell
+        I = i + g
+        ph = phi[j, i]
+        v[J, I] = vstar[J, I] - cy * (ph - phi[jm, i])
+        if i > 0:
+            u[J, I] = ustar[J, I] - cx * (ph - phi[j, i - 1])
+        if accumulate != 0:
+            p[J, I] = p[J, I] + ph
+        else:
+            p[J, I] = ph
     if j == ny - 1:
         for i in range(nx):
             v[J + 1, i + g] = vstar[J + 1, i + g]
+
+
+@wp.kernel
+def row_speeds(u: wp.array2d(dtype=wp.float64), v: wp.array2d(dtype=wp.float64),
+               hy_f: wp.array(dtype=wp.float64), g: int, nx: int, row0: int,
+               umax: wp.array(dtype=wp.float64), vrate: wp.array(dtype=wp.float64)):
+    """Per cell row j: umax[j] = max |u| over the row's u-faces (boundary faces included);
+    vrate[j] = max |v| / hy_f over the v-faces below the row, 0 for the bottom row (wall or
+    boundary faces; the time-step limit, ``Simulation.stable_dt``)."""
+    j = row0 + wp.tid()
+    J = j + g
+    m = wp.float64(0.0)
+    for i in range(nx + 1):
+        m = wp.max(m, wp.abs(u[J, i + g]))
+    umax[j] = m
+    mv = wp.float64(0.0)
+    if j > 0:
+        for i in range(nx):
+            mv = wp.max(mv, wp.abs(v[J, i + g]))
+        mv = mv / hy_f[J]
+    vrate[j] = mv
 
 
 # ----------------------------------------------------------------------------- boundary conditions

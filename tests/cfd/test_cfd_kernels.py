@@ -8,6 +8,7 @@ from cfd_helpers import DEVICES
 
 from bridge.cfd import CartesianGrid, FlowConfig, PoissonSolver, Simulation, circle, max_divergence, stretched_faces
 from bridge.cfd.advection import SCHEMES
+from bridge.cfd.grids import GHOST
 from bridge.cfd.launch import ROW0, RowLauncher
 from bridge.cfd.precision import DTYPE, WP_DTYPE
 from bridge.cfd.reference_numpy import NumpyFlow
@@ -51,6 +52,27 @@ def test_warp_step_matches_numpy_reference(device, grid_kind, scheme, pressure):
         a, b = getattr(sim, name).numpy(), getattr(ref, name)
         assert np.abs(a - b).max() <= 1e-11 * max(1.0, np.abs(b).max()), name
     assert sim.u.dtype == WP_DTYPE and ref.u.dtype == DTYPE
+
+
+@pytest.mark.parametrize("device", DEVICES)
+@pytest.mark.parametrize("grid_kind", sorted(GRIDS))
+def test_stable_dt_is_the_cfl_or_viscous_limit(device, grid_kind):
+    """dt = min(cfl / (max|u|/dx + max_j max_i |v|/hy_f), fourier h_min^2 / nu_max) on a random
+    state; the convective limit written out with NumPy over the interior faces (the wall-normal
+    faces at the bottom and top rows are zero)."""
+    grid = GRIDS[grid_kind]()
+    g, ny, nx = GHOST, *grid.shape
+    cfg = FlowConfig(nu=1e-4, cfl=0.4)
+    sim = Simulation(grid, cfg, device=device)
+    u, v, p = _random_state(grid, seed=4)
+    v[1:-1][2, 5] = -7.0  # the largest |v| is negative and not on the finest row
+    sim.set_state(u, v, p)
+    su, sv = sim.interior()[:2]
+    hf = grid.hy_faces()[g + 1:g + ny]
+    rate = np.abs(su).max() / grid.dx + (np.abs(sv[1:-1]).max(axis=1) / hf).max()
+    assert sim.stable_dt() == pytest.approx(0.4 / rate, rel=1e-14)
+    sim.set_viscosity(np.full((ny, nx), 50.0))
+    assert sim.stable_dt() == pytest.approx(cfg.fourier * grid.min_spacing ** 2 / 50.0, rel=1e-14)
 
 
 @pytest.mark.parametrize("device", DEVICES)
