@@ -77,11 +77,18 @@ def yflux_u_row(u: wp.array2d(dtype=wp.float64), v: wp.array2d(dtype=wp.float64)
     rm = hy_f[J] / hy_f[J - 1]
     rp = hy_f[J] / hy_f[J + 1]
     w = half * hy_c[J - 1] * ihf
+    # v and the column sum of nu left of the corner are carried along the row (one load each per corner)
+    vl = v[J, i_lo - 1]
+    nl = nu[J - 1, i_lo - 1] + nu[J, i_lo - 1]
     for I in range(i_lo, i_hi):
-        vc = half * (v[J, I - 1] + v[J, I])
-        nuc = wp.float64(0.25) * (nu[J - 1, I - 1] + nu[J - 1, I] + nu[J, I - 1] + nu[J, I])
-        flux[frow, I] = upwind_flux(vc, u[J - 2, I], u[J - 1, I], u[J, I], u[J + 1, I], rm, rp, w, scheme) \
-            - nuc * ((u[J, I] - u[J - 1, I]) * ihf + (v[J, I] - v[J, I - 1]) * idx)
+        vr = v[J, I]
+        nr = nu[J - 1, I] + nu[J, I]
+        ub = u[J - 1, I]
+        ua = u[J, I]
+        flux[frow, I] = upwind_flux(half * (vl + vr), u[J - 2, I], ub, ua, u[J + 1, I], rm, rp, w, scheme) \
+            - wp.float64(0.25) * (nl + nr) * ((ua - ub) * ihf + (vr - vl) * idx)
+        vl = vr
+        nl = nr
 
 
 @wp.func
@@ -136,18 +143,25 @@ def predict_u(u: wp.array2d(dtype=wp.float64), v: wp.array2d(dtype=wp.float64),
         hi = s + (J - r0 + 1) % 2
         yflux_u_row(u, v, nu, hy_c, hy_f, dx, J + 1, i_lo, i_hi, scheme, scratch, hi)
         ihc = one / hy_c[J]
+        # u[J, I-1 .. I+2] carried in registers along the row: one new load per face
         I = i_lo
-        uc = half * (u[J, I - 1] + u[J, I])
-        fl = upwind_flux(uc, u[J, I - 2], u[J, I - 1], u[J, I], u[J, I + 1], one, one, half, scheme) \
-            - two * nu[J, I - 1] * (u[J, I] - u[J, I - 1]) * idx
+        qm = u[J, I - 2]
+        qc = u[J, I - 1]
+        qp = u[J, I]
+        qpp = u[J, I + 1]
+        fl = upwind_flux(half * (qc + qp), qm, qc, qp, qpp, one, one, half, scheme) \
+            - two * nu[J, I - 1] * (qp - qc) * idx
         for I in range(i_lo, i_hi):
-            uc = half * (u[J, I] + u[J, I + 1])
-            fr = upwind_flux(uc, u[J, I - 1], u[J, I], u[J, I + 1], u[J, I + 2], one, one, half, scheme) \
-                - two * nu[J, I] * (u[J, I + 1] - u[J, I]) * idx
+            qm = qc
+            qc = qp
+            qp = qpp
+            qpp = u[J, I + 2]
+            fr = upwind_flux(half * (qc + qp), qm, qc, qp, qpp, one, one, half, scheme) \
+                - two * nu[J, I] * (qp - qc) * idx
             rhs = -(fr - fl) * idx - (scratch[hi, I] - scratch[lo, I]) * ihc
             if use_p != 0:
                 rhs -= (p[J, I] - p[J, I - 1]) * idx
-            out[J, I] = a * u0[J, I] + b * (u[J, I] + dt * rhs)
+            out[J, I] = a * u0[J, I] + b * (qc + dt * rhs)
             fl = fr
 
 
@@ -178,20 +192,35 @@ def predict_v(u: wp.array2d(dtype=wp.float64), v: wp.array2d(dtype=wp.float64),
         # weights of u rows J-1 and J at the corner height (face row J)
         wl = half * hy_c[J] * ihf
         wu = half * hy_c[J - 1] * ihf
+        # v[J, I-1 .. I+2] and, at the right corner, u below/above and the column sum of nu are
+        # carried in registers along the row (one new load of each per face)
         I = i_lo
-        ucl = wl * u[J - 1, I] + wu * u[J, I]
-        nul = quarter * (nu[J - 1, I - 1] + nu[J - 1, I] + nu[J, I - 1] + nu[J, I])
-        fl = upwind_flux(ucl, v[J, I - 2], v[J, I - 1], v[J, I], v[J, I + 1], one, one, half, scheme) \
-            - nul * ((v[J, I] - v[J, I - 1]) * idx + (u[J, I] - u[J - 1, I]) * ihf)
+        qm = v[J, I - 2]
+        qc = v[J, I - 1]
+        qp = v[J, I]
+        qpp = v[J, I + 1]
+        ub = u[J - 1, I]
+        ua = u[J, I]
+        nsum = nu[J - 1, I] + nu[J, I]
+        nul = quarter * (nu[J - 1, I - 1] + nu[J, I - 1] + nsum)
+        fl = upwind_flux(wl * ub + wu * ua, qm, qc, qp, qpp, one, one, half, scheme) \
+            - nul * ((qp - qc) * idx + (ua - ub) * ihf)
         for I in range(i_lo, i_hi):
-            ucr = wl * u[J - 1, I + 1] + wu * u[J, I + 1]
-            nur = quarter * (nu[J - 1, I] + nu[J - 1, I + 1] + nu[J, I] + nu[J, I + 1])
-            fr = upwind_flux(ucr, v[J, I - 1], v[J, I], v[J, I + 1], v[J, I + 2], one, one, half, scheme) \
-                - nur * ((v[J, I + 1] - v[J, I]) * idx + (u[J, I + 1] - u[J - 1, I + 1]) * ihf)
+            qm = qc
+            qc = qp
+            qp = qpp
+            qpp = v[J, I + 2]
+            ub = u[J - 1, I + 1]
+            ua = u[J, I + 1]
+            nnext = nu[J - 1, I + 1] + nu[J, I + 1]
+            nur = quarter * (nsum + nnext)
+            nsum = nnext
+            fr = upwind_flux(wl * ub + wu * ua, qm, qc, qp, qpp, one, one, half, scheme) \
+                - nur * ((qp - qc) * idx + (ua - ub) * ihf)
             rhs = -(fr - fl) * idx - (scratch[hi, I] - scratch[lo, I]) * ihf
             if use_p != 0:
                 rhs -= (p[J, I] - p[J - 1, I]) * ihf
-            out[J, I] = a * v0[J, I] + b * (v[J, I] + dt * rhs)
+            out[J, I] = a * v0[J, I] + b * (qc + dt * rhs)
             fl = fr
 
 
@@ -204,9 +233,12 @@ def divergence(u: wp.array2d(dtype=wp.float64), v: wp.array2d(dtype=wp.float64),
     J = j + g
     sx = scale / dx
     sy = scale / hy_c[J]
+    ul = u[J, g]
     for i in range(nx):
         I = i + g
-        div[j, i] = sx * (u[J, I + 1] - u[J, I]) + sy * (v[J + 1, I] - v[J, I])
+        ur = u[J, I + 1]
+        div[j, i] = sx * (ur - ul) + sy * (v[J + 1, I] - v[J, I])
+        ul = ur
 
 
 @wp.kernel
@@ -226,12 +258,14 @@ def project(ustar: wp.array2d(dtype=wp.float64), vstar: wp.array2d(dtype=wp.floa
     jm = wp.max(j - 1, 0)  # the bottom row's v-faces are boundary faces: copied (cy = 0)
     if j == 0:
         cy = wp.float64(0.0)
+    pl = phi[j, 0]
     for i in range(nx):  # one pass over the row: v-face, u-face and pressure of each cell
         I = i + g
         ph = phi[j, i]
         v[J, I] = vstar[J, I] - cy * (ph - phi[jm, i])
         if i > 0:
-            u[J, I] = ustar[J, I] - cx * (ph - phi[j, i - 1])
+            u[J, I] = ustar[J, I] - cx * (ph - pl)
+        pl = ph
         if accumulate != 0:
             p[J, I] = p[J, I] + ph
         else:
