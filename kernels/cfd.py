@@ -275,27 +275,6 @@ def project(ustar: wp.array2d(dtype=wp.float64), vstar: wp.array2d(dtype=wp.floa
             v[J + 1, i + g] = vstar[J + 1, i + g]
 
 
-@wp.kernel
-def row_speeds(u: wp.array2d(dtype=wp.float64), v: wp.array2d(dtype=wp.float64),
-               hy_f: wp.array(dtype=wp.float64), g: int, nx: int, row0: int,
-               umax: wp.array(dtype=wp.float64), vrate: wp.array(dtype=wp.float64)):
-    """Per cell row j: umax[j] = max |u| over the row's u-faces (boundary faces included);
-    vrate[j] = max |v| / hy_f over the v-faces below the row, 0 for the bottom row (wall or
-    boundary faces; the time-step limit, ``Simulation.stable_dt``)."""
-    j = row0 + wp.tid()
-    J = j + g
-    m = wp.float64(0.0)
-    for i in range(nx + 1):
-        m = wp.max(m, wp.abs(u[J, i + g]))
-    umax[j] = m
-    mv = wp.float64(0.0)
-    if j > 0:
-        for i in range(nx):
-            mv = wp.max(mv, wp.abs(v[J, i + g]))
-        mv = mv / hy_f[J]
-    vrate[j] = mv
-
-
 # ----------------------------------------------------------------------------- boundary conditions
 # Side codes: 0 slip (zero normal velocity, zero tangential gradient), 1 no-slip wall,
 # 2 inflow (Dirichlet, left only), 3 convective outflow (right only), 4 given (face values kept).
