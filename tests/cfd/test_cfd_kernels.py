@@ -56,10 +56,10 @@ def test_warp_step_matches_numpy_reference(device, grid_kind, scheme, pressure):
 
 @pytest.mark.parametrize("device", DEVICES)
 @pytest.mark.parametrize("grid_kind", sorted(GRIDS))
-def test_stable_dt_is_the_cfl_or_viscous_limit(device, grid_kind):
-    """dt = min(cfl / (max|u|/dx + max_j max_i |v|/hy_f), fourier h_min^2 / nu_max) on a random
-    state; the convective limit written out with NumPy over the interior faces (the wall-normal
-    faces at the bottom and top rows are zero)."""
+def test_stable_dt_combines_the_cfl_and_viscous_limits(device, grid_kind):
+    """1/dt = (max|u|/dx + max_j max_i |v|/hy_f)/cfl + nu_max/(fourier h_min^2) on a random state,
+    written out with NumPy over the interior faces (the wall-normal faces at the bottom and top rows
+    are zero), and stricter than either limit alone."""
     grid = GRIDS[grid_kind]()
     g, ny, nx = GHOST, *grid.shape
     cfg = FlowConfig(nu=1e-4, cfl=0.4)
@@ -70,9 +70,11 @@ def test_stable_dt_is_the_cfl_or_viscous_limit(device, grid_kind):
     su, sv = sim.interior()[:2]
     hf = grid.hy_faces()[g + 1:g + ny]
     rate = np.abs(su).max() / grid.dx + (np.abs(sv[1:-1]).max(axis=1) / hf).max()
-    assert sim.stable_dt() == pytest.approx(0.4 / rate, rel=1e-14)
-    sim.set_viscosity(np.full((ny, nx), 50.0))
-    assert sim.stable_dt() == pytest.approx(cfg.fourier * grid.min_spacing ** 2 / 50.0, rel=1e-14)
+    h2 = grid.min_spacing ** 2
+    assert sim.stable_dt() == pytest.approx(1.0 / (rate / 0.4 + 1e-4 / (cfg.fourier * h2)), rel=1e-14)
+    assert sim.stable_dt() < min(0.4 / rate, cfg.fourier * h2 / 1e-4)
+    sim.set_viscosity(np.full((ny, nx), 50.0))  # nu_max enters the viscous rate
+    assert sim.stable_dt() == pytest.approx(1.0 / (rate / 0.4 + 50.0 / (cfg.fourier * h2)), rel=1e-14)
 
 
 @pytest.mark.parametrize("device", DEVICES)
