@@ -192,8 +192,8 @@ def predict_v(u: wp.array2d(dtype=wp.float64), v: wp.array2d(dtype=wp.float64),
         # weights of u rows J-1 and J at the corner height (face row J)
         wl = half * hy_c[J] * ihf
         wu = half * hy_c[J - 1] * ihf
-        # v[J, I-1 .. I+2] and, at the right corner, u below/above and the column sum of nu are
-        # carried in registers along the row (one new load of each per face)
+        # v[J, I-1 .. I+2] and the column sum of nu are carried in registers along the row (one new
+        # load of each per face); u below/above the right corner is loaded once per face
         I = i_lo
         qm = v[J, I - 2]
         qc = v[J, I - 1]

@@ -195,24 +195,25 @@ class Simulation:
     def stable_dt(self) -> float:
         """dt from the convective and viscous limits together; the fixed dt if configured.
 
-        1/dt = rate/cfl + nu_max/(fourier h_min^2), rate = max|u|/dx + max|v|/hy: each limit alone
-        where the other rate is zero, and stricter than the smaller of the two where both matter.
-        Taking only the smaller one let the explicit step run unstable where both were close to their
-        limits: DFG 2D-1 at D/32 settled into a bounded oscillation one diameter above the cylinder
-        (max u 0.59 against 0.40), with c_L -0.006 instead of 0.011 (docs/validation.md).
+        1/dt = rate/cfl + nu_max/(fourier h_min^2), rate = max|u|/dx + max|v|/hy: the viscous limit
+        alone with the fluid at rest, close to the convective limit where viscosity is negligible, and
+        stricter than the smaller of the two where both matter. Taking only the smaller one let DFG
+        2D-1 at D/32 (viscous limit 1.95e-3, convective about 2.6e-3) settle into a bounded
+        oscillation one diameter above the cylinder (max u 0.59 against 0.40) with c_L -0.006
+        instead of 0.011 (docs/validation.md).
         """
         c = self.config
         if c.dt is not None:
             return c.dt
-        # NumPy reductions on zero-copy views, max|q| = max(max q, -min q): 0.48 ms at 1024 x 512, where
-        # a Warp row kernel took 0.86 ms (scalar loop; tools/bench_cfd.py conditions, 2026-11-30)
+        # NumPy reductions on views (zero-copy on the CPU), max|q| = max(max q, -min q): 0.48 ms at
+        # 1024 x 512 where a Warp row kernel took 0.86 ms (scalar loop; bench_cfd's flow, 2026-11-30)
         g, nx, ny = GHOST, self.grid.nx, self.grid.ny
         u = self.u.numpy()[g:g + ny, g:g + nx + 1]
         v = self.v.numpy()[g + 1:g + ny, g:g + nx]
         h = self.grid.min_spacing
         rate = max(u.max(), -u.min()) / self.grid.dx \
             + (np.maximum(v.max(axis=1), -v.min(axis=1)) / self._hf_inner).max()
-        if not np.isfinite(rate):  # non-finite fields: the viscous limit, and the NaN monitor reports them
+        if not np.isfinite(rate):  # non-finite fields: the viscous limit; a NaNMonitor, if attached, stops the run
             rate = 0.0
         inv_dt = rate / c.cfl + self.nu_max / (c.fourier * h * h)
         return float(min(1.0 / inv_dt, c.dt_max))

@@ -156,8 +156,8 @@ def test_dfg_pressure_difference_at_d16():
     flow is steady by then to 1e-3). Checks that the pressure next to an immersed wall is the wall
     pressure: before the forced faces were compensated for the projection the difference was 0.141
     (+20 %) on every grid, with c_D within 2 %. Measured now (pressure from the nearest cells without
-    forced faces, quadratic extrapolation): 0.1164 (-1.0 %), c_D 5.630 (+0.9 %). Tolerances 3 % and
-    2 %: the D/16 discretisation error, not a fit (D/32: 0.1171, 5.593)."""
+    forced faces, quadratic extrapolation) at t = 8: 0.1163 (-1.0 %), c_D 5.630 (+0.9 %). Tolerances
+    3 % and 2 %: the D/16 discretisation error, not a fit (D/32: 0.1169, 5.583)."""
     res = load_tool("validate_cfd").dfg(16, 4.0, 2, "vanleer")
     assert abs(res["dp"] / 0.11752 - 1) < 0.03, res["dp"]
     assert abs(res["c_D"] / 5.5795 - 1) < 0.02, res["c_D"]

@@ -8,7 +8,6 @@ from cfd_helpers import DEVICES
 
 from bridge.cfd import CartesianGrid, FlowConfig, PoissonSolver, Simulation, circle, max_divergence, stretched_faces
 from bridge.cfd.advection import SCHEMES
-from bridge.cfd.grids import GHOST
 from bridge.cfd.launch import ROW0, RowLauncher
 from bridge.cfd.precision import DTYPE, WP_DTYPE
 from bridge.cfd.reference_numpy import NumpyFlow
@@ -57,24 +56,31 @@ def test_warp_step_matches_numpy_reference(device, grid_kind, scheme, pressure):
 @pytest.mark.parametrize("device", DEVICES)
 @pytest.mark.parametrize("grid_kind", sorted(GRIDS))
 def test_stable_dt_combines_the_cfl_and_viscous_limits(device, grid_kind):
-    """1/dt = (max|u|/dx + max_j max_i |v|/hy_f)/cfl + nu_max/(fourier h_min^2) on a random state,
+    """1/dt = (max|u|/dx + max_j max_i |v|/dy_j)/cfl + nu_max/(fourier h_min^2) on a random state,
     written out with NumPy over the interior faces (the wall-normal faces at the bottom and top rows
-    are zero), and stricter than either limit alone."""
+    are zero; dy_j the distance between the cell centres on either side of v-face row j), stricter
+    than either limit alone; non-finite fields fall back to the viscous limit; dt_max caps it."""
     grid = GRIDS[grid_kind]()
-    g, ny, nx = GHOST, *grid.shape
+    ny, nx = grid.shape
     cfg = FlowConfig(nu=1e-4, cfl=0.4)
     sim = Simulation(grid, cfg, device=device)
     u, v, p = _random_state(grid, seed=4)
+    u[ny // 2, 7] = -9.0  # the largest |u| is negative
     v[1:-1][2, 5] = -7.0  # the largest |v| is negative and not on the finest row
     sim.set_state(u, v, p)
     su, sv = sim.interior()[:2]
-    hf = grid.hy_faces()[g + 1:g + ny]
-    rate = np.abs(su).max() / grid.dx + (np.abs(sv[1:-1]).max(axis=1) / hf).max()
+    dy = np.diff(grid.y_centres)  # between cell rows j-1 and j: v-face rows 1 .. ny-1
+    rate = np.abs(su).max() / grid.dx + (np.abs(sv[1:-1]).max(axis=1) / dy).max()
     h2 = grid.min_spacing ** 2
     assert sim.stable_dt() == pytest.approx(1.0 / (rate / 0.4 + 1e-4 / (cfg.fourier * h2)), rel=1e-14)
     assert sim.stable_dt() < min(0.4 / rate, cfg.fourier * h2 / 1e-4)
     sim.set_viscosity(np.full((ny, nx), 50.0))  # nu_max enters the viscous rate
     assert sim.stable_dt() == pytest.approx(1.0 / (rate / 0.4 + 50.0 / (cfg.fourier * h2)), rel=1e-14)
+    sim.u.assign(np.where(np.isnan(sim.u.numpy()), 0.0, np.nan))  # a diverged field
+    assert sim.stable_dt() == pytest.approx(cfg.fourier * h2 / 50.0, rel=1e-14)
+    capped = Simulation(grid, FlowConfig(nu=1e-4, cfl=0.4, dt_max=1e-9), device=device)
+    capped.set_state(u, v, p)
+    assert capped.stable_dt() == 1e-9
 
 
 @pytest.mark.parametrize("device", DEVICES)
