@@ -169,17 +169,23 @@ class ImmersedBody:
         import scipy.sparse as sp
         from scipy.sparse.linalg import factorized
 
+        # face states on a window of storage covering both boxes (cells J0.., I0..)
+        bu, bv = self.boxes[0], self.boxes[1]
+        J0, I0 = min(bu["j0"], bv["j0"]), min(bu["i0"], bv["i0"])
+        nj = max(bu["j0"] + bu["nj"], bv["j0"] + bv["nj"]) - J0
+        ni = max(bu["i0"] + bu["ni"], bv["i0"] + bv["ni"]) - I0
         st = {}
-        for c in (0, 1):
+        for c, shape in ((0, (nj, ni + 1)), (1, (nj + 1, ni))):
             b = self.boxes[c]
-            a = np.zeros(self.grid.storage_shape("uv"[c]), dtype=np.int32)
-            a[b["j0"]:b["j0"] + b["nj"], b["i0"]:b["i0"] + b["ni"]] = b["state"].numpy()
+            a = np.zeros(shape, dtype=np.int32)
+            a[b["j0"] - J0:b["j0"] - J0 + b["nj"], b["i0"] - I0:b["i0"] - I0 + b["ni"]] = b["state"].numpy()
             st[c] = a
         su, sv = st[0], st[1]
         # cell (J, I): u-faces (J, I) and (J, I + 1), v-faces (J, I) and (J + 1, I)
         all_forced = (su[:, :-1] != 0) & (su[:, 1:] != 0) & (sv[:-1, :] != 0) & (sv[1:, :] != 0)
         touches = (su[:, :-1] == 2) | (su[:, 1:] == 2) | (sv[:-1, :] == 2) | (sv[1:, :] == 2)
-        J, I = np.nonzero(all_forced & touches)
+        j, i = np.nonzero(all_forced & touches)
+        J, I = j + J0, i + I0
         n = J.size
         if n == 0:
             return None
@@ -188,7 +194,7 @@ class ImmersedBody:
         faces = []  # (component, flat index in its box, outward flux per unit velocity, is interface)
         for c, FJ, FI, w in ((0, J, I + 1, hy), (0, J, I, -hy), (1, J + 1, I, wx), (1, J, I, -wx)):
             b = self.boxes[c]
-            faces.append((c, (FJ - b["j0"]) * b["ni"] + (FI - b["i0"]), w, st[c][FJ, FI] == 2))
+            faces.append((c, (FJ - b["j0"]) * b["ni"] + (FI - b["i0"]), w, st[c][FJ - J0, FI - I0] == 2))
         big = max(self.boxes[c]["nj"] * self.boxes[c]["ni"] for c in (0, 1))
         rows = np.concatenate([np.nonzero(f[3])[0] for f in faces])
         keys = np.concatenate([f[0] * big + f[1][f[3]] for f in faces])
