@@ -231,16 +231,24 @@ class ImmersedBody:
         latest ``apply``. The pressure of such a cell is set by the forcing as much as by the flow (a
         DFG probe on a cell with three forced faces read a pressure difference of 81 instead of 0.12),
         so pressure probes use the other cells."""
+        return self._cells(lambda state: state != 0, np.logical_or)
+
+    def solid_cells(self) -> np.ndarray:
+        """Cells (ny, nx) whose four faces are all inside the body (latest ``apply``)."""
+        return self._cells(lambda state: state == 1, np.logical_and)
+
+    def _cells(self, face_test, combine) -> np.ndarray:
+        """Cells whose faces pass ``face_test`` (on the face states), combined over the four faces."""
         g, nx, ny = GHOST, self.grid.nx, self.grid.ny
-        out = np.zeros((ny, nx), dtype=bool)
+        out = None
         for comp, (dj, di) in ((0, (0, 1)), (1, (1, 0))):
             b = self.boxes.get(comp)
-            if b is None:
-                continue
-            forced = np.zeros(self.grid.storage_shape("uv"[comp]), dtype=bool)
-            forced[b["j0"]:b["j0"] + b["nj"], b["i0"]:b["i0"] + b["ni"]] = b["state"].numpy() != 0
+            mask = np.zeros(self.grid.storage_shape("uv"[comp]), dtype=bool)
+            if b is not None:
+                mask[b["j0"]:b["j0"] + b["nj"], b["i0"]:b["i0"] + b["ni"]] = face_test(b["state"].numpy())
             # the cell's two faces of this component: storage (J, I) and (J + dj, I + di)
-            out |= forced[g:g + ny, g:g + nx] | forced[g + dj:g + dj + ny, g + di:g + di + nx]
+            both = combine(mask[g:g + ny, g:g + nx], mask[g + dj:g + dj + ny, g + di:g + di + nx])
+            out = both if out is None else combine(out, both)
         return out
 
     def reset_impulse(self):
