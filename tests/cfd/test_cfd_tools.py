@@ -24,6 +24,9 @@ def test_validate_cfd_runs_tiny(tmp_path):
     (res,) = load_tool("validate_cfd").main(["cylinder", "--re", "20", "--ppd", "4", "--t-end", "0.1",
                                              "--out", str(out)])
     assert np.isfinite(res["C_D"])
+    (res,) = load_tool("validate_cfd").main(["heave", "--shape", "deck", "--ppd", "6", "--t-end", "0.5",
+                                             "--window", "0.4", "--out", str(out)])
+    assert res["shape"] == "deck" and np.all(np.isfinite(res["first_harmonic_amplitude"]))
     assert len(out.read_text().splitlines()) == 2
     # --ny-shift: one run per shift, the channel keeps its height with more (or fewer) cells across
     shifted = load_tool("validate_cfd").main(["dfg", "--ppd", "6", "--t-end", "0.02", "--ny-shift", "-1", "2",
