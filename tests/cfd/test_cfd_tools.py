@@ -27,14 +27,14 @@ def test_validate_cfd_runs_tiny(tmp_path):
     (res,) = load_tool("validate_cfd").main(["heave", "--shape", "deck", "--ppd", "6", "--t-end", "0.5",
                                              "--window", "0.4", "--out", str(out)])
     assert res["shape"] == "deck" and np.all(np.isfinite(res["first_harmonic_amplitude"]))
-    assert len(out.read_text().splitlines()) == 2
+    assert len(out.read_text().splitlines()) == 3
     # --ny-shift: one run per shift, the channel keeps its height with more (or fewer) cells across
     shifted = load_tool("validate_cfd").main(["dfg", "--ppd", "6", "--t-end", "0.02", "--ny-shift", "-1", "2",
                                               "--out", str(out)])
     assert [r["ny"] for r in shifted] == [24, 27] and [r["ny_shift"] for r in shifted] == [-1, 2]
     with pytest.raises(SystemExit):  # no cells left: refused before any run
         load_tool("validate_cfd").main(["dfg", "--ppd", "6", "--ny-shift", "-25", "--out", str(out)])
-    assert len(out.read_text().splitlines()) == 4
+    assert len(out.read_text().splitlines()) == 5
 
 
 @pytest.mark.parametrize("tool, argv, option", [
