@@ -86,11 +86,12 @@ def test_added_mass_of_an_oscillating_cylinder_converges():
     J. Fluid Mech. 32): C_m = 1 + 4 (pi beta)^-1/2 + (pi beta)^-3/2 = 1.320 unbounded; the closed 8D
     box adds about 3 % to the potential part ((R_o^2 + R^2)/(R_o^2 - R^2) = 1.032 for a circular
     container of radius 4 D), so C_ref is about 1.35. Checks the forcing impulse and the internal-fluid
-    correction together, and how fast they converge. Measured: 1.534 / 1.445 / 1.409 at D/16 / 24 /
-    32, and 1.380 / 1.369 at D/48 / 64 with the same set-up (observed order 1.63 from 16/32/64,
-    extrapolated 1.350). Asserted from the three coarse grids (order 1.67, limit 1.352): the order and
-    the extrapolated limit against C_ref; limits 1.3 and 4 %, wider than the scatter over all ten
-    triples of the five grids (order 1.59-1.67, limit 1.349-1.352) and the uncertainty of the
+    correction together, and how fast they converge. Measured (with the target closure): 1.546 /
+    1.449 / 1.412 at D/16 / 24 / 32, and 1.382 / 1.370 at D/48 / 64 with the same set-up (observed
+    order 1.67 from 16/32/64, extrapolated 1.351). Asserted from the three coarse grids (order 1.72,
+    limit 1.354): the order and the extrapolated limit against C_ref; limits 1.3 and 4 %, wider than
+    the scatter over all ten triples of the five grids (order 1.63-1.72, limit 1.350-1.354) and the
+    uncertainty of the
     confinement estimate."""
     n = np.array([16, 24, 32])
     c = np.array([_added_mass_coefficient(k) for k in n])
