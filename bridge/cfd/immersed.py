@@ -22,15 +22,15 @@ Neumann condition on the interface.
 Mass (``_close_targets``): a cell whose four faces are all forced (solid faces and interface faces
 together) gets no free face for the projection to adjust, and the interpolated interface targets
 do not in general add up to zero flux there. Left alone, the projection carried the mismatch through
-the body (solid faces at 1 % of the mean flow in DFG 2D-1, at every resolution), the pressure inside
+the body (solid faces at 1-2 % of the mean flow in DFG 2D-1, not shrinking with h), the pressure inside
 the body grew by a fixed amount every step (linearly, without bound), and a moving body, whose
 cells change class as it moves, felt that pressure as step-to-step force noise (heaving cylinder,
 D/16: the second difference of the lift 0.90 rms against 0.05 with the fix). So after interpolation
 the interface targets get the least change (sum of squares) that makes every such cell
 divergence-free: delta = -A^T (A A^T)^-1 r, A the flux of each interface face into the cells, r the
 cells' net flux. The fluid then sees an impermeable body and the interior pressure stays bounded; the
-first harmonic of the forces on a heaving body moved by < 0.5 %, DFG 2D-1 c_D by +0.03 % and dp by
--0.15 % at D/48 (docs/validation.md).
+first harmonic of the forces on a heaving body moved by < 0.6 %, DFG 2D-1 c_D by +0.03 % and dp by
+-0.1 % at D/48 (docs/validation.md).
 
 Force (per unit length, ``rho`` times the kinematic quantities): the momentum the forcing adds to the
 grid fluid over a step, M (each stage's contribution weighted by how it enters the final stage), is

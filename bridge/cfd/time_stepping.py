@@ -12,8 +12,9 @@ projection step (Chorin 1968):
   u_{k+1} = u* - b dt G phi,   p = phi [p <- p + phi]     projection (kernel project)
 The bracketed terms are the incremental form (van Kan 1986, ``pressure="incremental"``); the default
 "full" form leaves the pressure out of the predictor: with the incremental form the pressure inside an
-immersed body grew without bound (interface blow-up at D/16), the full form is stable and the velocity
-stays second order in time (tests/cfd/test_cfd_convergence.py).
+immersed body grew without bound (interface blow-up at D/16) until the body's targets were closed
+(immersed.py, Mass; it runs since), the full form is stable and the velocity stays second order in
+time (tests/cfd/test_cfd_convergence.py).
 State arrays are preallocated and mutated in place: stage 1 writes the stage buffers (u_k), the last
 stage overwrites the state (u); ``u_star`` is scratch. Ghosts are refreshed after every projection.
 
