@@ -266,14 +266,14 @@ def main(argv=None):
     _check_args(ap, args)
     results = []
     for ppd in args.ppd:
-        for shift in (args.ny_shift if args.case == "dfg" else args.shape if args.case == "heave" else [0]):
+        for variant in (args.ny_shift if args.case == "dfg" else args.shape if args.case == "heave" else [0]):
             if args.case == "heave":
-                r = heave(shift, ppd, args.re, args.t_end, args.window, args.threads, args.advection)
+                r = heave(variant, ppd, args.re, args.t_end, args.window, args.threads, args.advection)
             elif args.case == "cylinder":
                 r = cylinder(args.re, ppd, args.t_end, args.window, args.threads, args.advection,
                              *args.domain, ib_order=args.ib_order)
             else:
-                r = dfg(ppd, args.t_end, args.threads, args.advection, args.ib_order, shift)
+                r = dfg(ppd, args.t_end, args.threads, args.advection, args.ib_order, variant)
             r["command"] = command
             _emit(r, args.out)
             results.append(r)

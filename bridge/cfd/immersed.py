@@ -47,7 +47,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import scipy.sparse as sp
 import warp as wp
+from scipy.sparse.linalg import factorized
 
 from kernels import cfd as _k
 
@@ -166,20 +168,12 @@ class ImmersedBody:
         those interface faces. Returns the constraint A (flux per unit velocity, rows x unknowns),
         a factorised A A^T, the four faces of every row (for the residual) and where the unknowns lie.
         """
-        import scipy.sparse as sp
-        from scipy.sparse.linalg import factorized
-
         # face states on a window of storage covering both boxes (cells J0.., I0..)
         bu, bv = self.boxes[0], self.boxes[1]
         J0, I0 = min(bu["j0"], bv["j0"]), min(bu["i0"], bv["i0"])
         nj = max(bu["j0"] + bu["nj"], bv["j0"] + bv["nj"]) - J0
         ni = max(bu["i0"] + bu["ni"], bv["i0"] + bv["ni"]) - I0
-        st = {}
-        for c, shape in ((0, (nj, ni + 1)), (1, (nj + 1, ni))):
-            b = self.boxes[c]
-            a = np.zeros(shape, dtype=np.int32)
-            a[b["j0"] - J0:b["j0"] - J0 + b["nj"], b["i0"] - I0:b["i0"] - I0 + b["ni"]] = b["state"].numpy()
-            st[c] = a
+        st = {0: self._face_states(0, J0, I0, (nj, ni + 1)), 1: self._face_states(1, J0, I0, (nj + 1, ni))}
         su, sv = st[0], st[1]
         # cell (J, I): u-faces (J, I) and (J, I + 1), v-faces (J, I) and (J + 1, I)
         all_forced = (su[:, :-1] != 0) & (su[:, 1:] != 0) & (sv[:-1, :] != 0) & (sv[1:, :] != 0)
@@ -226,6 +220,15 @@ class ImmersedBody:
             if not self.L.device.is_cpu:  # .numpy() copied the device array
                 self.boxes[c]["target"].assign(host[c])
 
+    def _face_states(self, comp, J0, I0, shape) -> np.ndarray:
+        """States (0 fluid, 1 solid, 2 interface) of the ``comp`` faces of the latest ``apply`` on a
+        window of storage starting at (J0, I0); faces outside the body's box are fluid."""
+        out = np.zeros(shape, dtype=np.int32)
+        b = self.boxes.get(comp)
+        if b is not None:
+            out[b["j0"] - J0:b["j0"] - J0 + b["nj"], b["i0"] - I0:b["i0"] - I0 + b["ni"]] = b["state"].numpy()
+        return out
+
     def forced_cells(self) -> np.ndarray:
         """Cells (ny, nx) with at least one face forced (inside the body or at its interface) by the
         latest ``apply``. The pressure of such a cell is set by the forcing as much as by the flow (a
@@ -242,10 +245,7 @@ class ImmersedBody:
         g, nx, ny = GHOST, self.grid.nx, self.grid.ny
         out = None
         for comp, (dj, di) in ((0, (0, 1)), (1, (1, 0))):
-            b = self.boxes.get(comp)
-            mask = np.zeros(self.grid.storage_shape("uv"[comp]), dtype=bool)
-            if b is not None:
-                mask[b["j0"]:b["j0"] + b["nj"], b["i0"]:b["i0"] + b["ni"]] = face_test(b["state"].numpy())
+            mask = face_test(self._face_states(comp, 0, 0, self.grid.storage_shape("uv"[comp])))
             # the cell's two faces of this component: storage (J, I) and (J + dj, I + di)
             both = combine(mask[g:g + ny, g:g + nx], mask[g + dj:g + dj + ny, g + di:g + di + nx])
             out = both if out is None else combine(out, both)
