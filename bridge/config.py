@@ -20,6 +20,7 @@ stored twice.
 from __future__ import annotations
 
 import math
+import re
 import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field, fields, replace
@@ -30,7 +31,7 @@ from .errors import InputError, check_range
 
 __all__ = [
     "Material", "BoxSection", "Geometry", "Girder", "Cable", "Hanger", "Pylon", "DampingEntry", "Air",
-    "Scenario", "load_scenario", "scenario_path", "SCENARIO_DIR", "GRAVITY_M_S2",
+    "Scenario", "load_scenario", "scenario_path", "check_name", "SCENARIO_DIR", "GRAVITY_M_S2",
 ]
 
 GRAVITY_M_S2 = 9.81  # the thesis's value (Eq 1.2, 2.3)
@@ -446,6 +447,18 @@ def _parse_optional_tables(t: _Table, scenario: Scenario) -> Scenario:
     return replace(scenario, **updates) if updates else scenario
 
 
+_NAME = re.compile(r"[A-Za-z0-9_-][A-Za-z0-9._-]*")
+
+
+def check_name(name: Any, where: str = "name") -> str:
+    """A scenario name is the name of its result folder: a plain file name of letters, digits, ``-``,
+    ``_`` and ``.``, not starting with ``.`` (so never ``..``, a path or a hidden folder)."""
+    if not isinstance(name, str) or not _NAME.fullmatch(name) or len(name) > 200:
+        raise InputError(where, name, "must be a plain file name: letters, digits, '-', '_' and '.', "
+                         "not starting with '.' (at most 200 characters)")
+    return name
+
+
 def scenario_path(name_or_path: str | Path) -> Path:
     """``great_belt`` -> ``scenarios/great_belt.toml``; an existing path is used as given."""
     p = Path(name_or_path)
@@ -498,7 +511,10 @@ def load_scenario(name_or_path: str | Path, main_span_m: float | None = None,
         data = apply_overrides(data, overrides)
         overrides = {}
     t = _Table(data, "")
-    name = t.string("name", default=path.stem)
+    if "name" in data:
+        name = check_name(t.string("name"))
+    else:  # the file's own name: a copy saved under another name writes to its own folder
+        name = check_name(path.stem, f"name (from the file name {path.name}; rename the file or set name = ...)")
     description = t.string("description", default="")
 
     if "reference" in data:  # an up-scaled bridge

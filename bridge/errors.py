@@ -6,6 +6,8 @@ into exit status 2.  ``ConvergenceError`` says which iteration failed and its la
 
 from __future__ import annotations
 
+import math
+
 __all__ = ["InputError", "ConvergenceError", "check_range"]
 
 
@@ -30,15 +32,15 @@ class ConvergenceError(RuntimeError):
 
 def check_range(key: str, value: float, low: float | None = None, high: float | None = None,
                 low_open: bool = False, high_open: bool = False) -> float:
-    """Return ``float(value)`` if it lies in the range, else raise :class:`InputError` naming it.
+    """Return ``float(value)`` if it is finite and lies in the range, else raise :class:`InputError` naming it.
 
     ``low_open``/``high_open`` exclude the end point (``low_open=True, low=0`` means "> 0").
     """
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise InputError(key, value, "must be a number")
     v = float(value)
-    if v != v:
-        raise InputError(key, value, "must be a number, not NaN")
+    if not math.isfinite(v):  # NaN fails every comparison and inf passes every open range: refuse both
+        raise InputError(key, value, "must be a finite number")
     lo_ok = low is None or (v > low if low_open else v >= low)
     hi_ok = high is None or (v < high if high_open else v <= high)
     if not (lo_ok and hi_ok):

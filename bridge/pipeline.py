@@ -1,8 +1,9 @@
 """Running a scenario through its stages and writing the results.
 
 ``run_scenario`` is what ``python -m bridge.scenario`` and the sweeps call: it resolves the requested
-stages with their prerequisites, runs them in order, and hands every output to
-:func:`bridge.results.write_results` (atomic: nothing is left behind if a stage fails).
+stages with their prerequisites, runs them in order (taking each from the stage cache,
+:mod:`bridge.cache`, when ``options.cache`` is set and its inputs are unchanged), and hands every output
+to :func:`bridge.results.write_results` (atomic: nothing is left behind if a stage fails).
 """
 
 from __future__ import annotations
@@ -10,6 +11,7 @@ from __future__ import annotations
 from collections.abc import Iterable
 from pathlib import Path
 
+from . import cache
 from .config import Scenario
 from .errors import InputError
 from .results import write_results
@@ -29,6 +31,8 @@ def default_stages(scenario: Scenario) -> tuple[str, ...]:
 def plan_stages(scenario: Scenario, requested: Iterable[str] | None) -> tuple[str, ...]:
     """Requested stages plus their prerequisites, in registry order; unknown names are an InputError."""
     wanted = list(requested) if requested is not None else list(default_stages(scenario))
+    if not wanted:
+        raise InputError("--stages", ",".join(wanted), f"no stage named; known: {', '.join(STAGES)}")
     for name in wanted:
         if name not in STAGES:
             raise InputError("--stages", name, f"unknown stage; known: {', '.join(STAGES)}")
@@ -38,7 +42,7 @@ def plan_stages(scenario: Scenario, requested: Iterable[str] | None) -> tuple[st
         if name in needed:
             return
         needed.add(name)
-        for dep in STAGES[name][1]:
+        for dep in STAGES[name].needs:
             if scenario.kind in ("section", "modal") and dep in ("cable", "fem"):
                 continue  # a sectional model or given modes carry their own modal data
             need(dep)
@@ -55,17 +59,44 @@ def plan_stages(scenario: Scenario, requested: Iterable[str] | None) -> tuple[st
 
 def run_stages(scenario: Scenario, stages: Iterable[str] | None = None,
                options: RunOptions | None = None) -> dict[str, StageOutput]:
-    """Run the planned stages in memory and return their outputs (no files written)."""
+    """Run the planned stages and return their outputs (no result files written).
+
+    With ``options.cache`` set, a stage whose key (:func:`bridge.cache.stage_key`) is stored is taken
+    from the cache (and says so); a computed stage is stored there.  Outputs from this path are
+    self-contained (:func:`bridge.cache.store`); without a cache they are returned as the stage made them.
+    """
     options = options or RunOptions()
     outputs: dict[str, StageOutput] = {}
+    keys: dict[str, str] = {}
     for name in plan_stages(scenario, stages):
-        outputs[name] = resolve_stage(name)(scenario, outputs, options)
+        if options.cache is None:
+            outputs[name] = resolve_stage(name)(scenario, outputs, options)
+            continue
+        keys[name] = cache.stage_key(name, scenario, {d: keys[d] for d in STAGES[name].needs if d in keys},
+                                     options.quick)
+        hit = cache.load(options.cache, name, keys[name])
+        if hit is not None:
+            options.say(f"[{scenario.name}] {name}: inputs unchanged, reusing the stored result "
+                        f"({options.cache / name / keys[name][:12]}...)")
+            outputs[name] = hit
+            continue
+        out = cache.store(resolve_stage(name)(scenario, outputs, options))
+        cache.save(options.cache, name, keys[name], out)
+        outputs[name] = out
     return outputs
 
 
 def run_scenario(scenario: Scenario, out_dir: Path, stages: Iterable[str] | None = None,
-                 options: RunOptions | None = None) -> tuple[Path, dict[str, StageOutput]]:
-    """Run the stages and write ``out_dir/<scenario.name>/``; return that folder and the outputs."""
+                 options: RunOptions | None = None, overwrite: bool = False,
+                 run_key: str | None = None) -> tuple[Path, dict[str, StageOutput]]:
+    """Run the stages and write ``out_dir/<scenario.name>/``; return that folder and the outputs.
+
+    An existing result folder is an :class:`InputError` unless ``overwrite`` (then the files of the
+    earlier run are replaced and any other file there is kept); see :func:`bridge.results.write_results`.
+    """
+    from .results import check_target
+
+    check_target(Path(out_dir), scenario.name, overwrite)
     outputs = run_stages(scenario, stages, options)
-    folder = write_results(Path(out_dir), scenario, outputs)
+    folder = write_results(Path(out_dir), scenario, outputs, overwrite=overwrite, run_key=run_key)
     return folder, outputs

@@ -1,14 +1,24 @@
 """Writing a run's results: ``results.h5``, ``summary.json``, ``report.md`` and PNG plots.
 
-Everything is written into a temporary folder beside the target and renamed into place at the end, so
-a failed run leaves no partial results (an earlier complete result of the same scenario is replaced only
-once the new one is complete).  The HDF5 schema is documented in ``docs/results.md``.
+Results are never lost or misplaced:
+
+* a result folder that exists is not replaced unless the caller says ``overwrite`` (command line
+  ``--overwrite``); then only the files the earlier run wrote (listed in its ``summary.json`` under
+  ``run.files``) are replaced, and every other file in the folder is kept;
+* everything is written into a temporary folder beside the target, and the finished folder is renamed
+  into place: a failed or interrupted run leaves the earlier result as it was;
+* every file gets the same permissions (:mod:`bridge.files`); ``summary.json`` is strict JSON (RFC 8259:
+  ``null`` for a number that does not exist, ``true``/``false`` for flags, never NaN or Infinity).
+
+The HDF5 schema is documented in ``docs/results.md``.
 """
 
 from __future__ import annotations
 
 import json
+import math
 import os
+import re
 import shutil
 import tempfile
 from collections.abc import Mapping
@@ -21,9 +31,11 @@ import numpy as np
 
 from . import __version__
 from .config import Scenario, scenario_fields
+from .errors import InputError
+from .files import file_mode, folder_mode
 from .stages import StageOutput
 
-__all__ = ["write_results", "write_dataset"]
+__all__ = ["write_results", "write_dataset", "check_target", "summary_json", "headline", "SCHEMA_VERSION"]
 
 SCHEMA_VERSION = "1"
 
@@ -40,21 +52,143 @@ def write_dataset(group: h5py.Group, name: str, data: Any, unit: str = "", descr
         ds.attrs["description"] = description
 
 
-def _summary_value(v: Any) -> Any:
+def _json_value(v: Any) -> Any:
+    """A summary value as strict JSON: NumPy scalars unwrapped, NaN and infinities as null."""
+    if isinstance(v, (np.bool_, bool)):
+        return bool(v)
     if isinstance(v, (np.floating, np.integer)):
-        return v.item()
+        v = v.item()
+    if isinstance(v, float) and not math.isfinite(v):
+        return None
+    if isinstance(v, (list, tuple)):
+        return [_json_value(x) for x in v]
     return v
 
 
-def write_results(out_root: Path, scenario: Scenario, outputs: Mapping[str, StageOutput]) -> Path:
-    """Write all stage outputs of ``scenario`` to ``out_root/<scenario.name>/`` atomically; return that folder."""
-    import matplotlib
+def summary_json(summary: Mapping[str, Any]) -> str:
+    """``summary`` as strict JSON text (raises ValueError rather than write NaN or Infinity)."""
+    return json.dumps({k: _json_value(v) for k, v in summary.items()}, indent=2, allow_nan=False) + "\n"
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
 
+def _fmt(v: Any, spec: str, unit: str = "") -> str | None:
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+        return None
+    return f"{v:{spec}}{unit}"
+
+
+def headline(summary: Mapping[str, Any]) -> list[str]:
+    """The few numbers a user runs the program for, one line each, from the summary keys of the stages
+    that ran: the flutter speed with its frequency and governing modes, the multimode speed and the
+    divergence speed; without the flutter stage, the first frequencies or the cable force."""
+    s, lines = summary, []
+    if "flutter.critical_speed_m_s" in s:
+        vc = _fmt(s.get("flutter.critical_speed_m_s"), ".1f", " m/s")
+        aero = s.get("flutter.aerodynamics")
+        aero = f", {aero} aerodynamics" if isinstance(aero, str) else ""
+        if vc is None:
+            top = _fmt(s.get("flutter.max_speed_searched_m_s"), ".0f", " m/s") or "the highest speed searched"
+            lines.append(f"no flutter of any mode pair below {top}{aero}")
+        else:
+            f = _fmt(s.get("flutter.frequency_hz"), ".4f", " Hz")
+            om = _fmt(s.get("flutter.reduced_frequency"), ".3f")
+            lines.append(f"flutter speed V_c = {vc} at f = {f} (Omega = {om}), governing modes "
+                         f"{s.get('flutter.mode_pair')} (two-mode determinant{aero})")
+        if "flutter.multimode_critical_speed_m_s" in s:
+            mm = _fmt(s.get("flutter.multimode_critical_speed_m_s"), ".1f", " m/s")
+            lines.append(f"multimode p-k V_c = {mm}" if mm else "multimode p-k: no flutter in the speeds searched")
+        if "flutter.divergence_speed_m_s" in s:
+            dv = _fmt(s.get("flutter.divergence_speed_m_s"), ".1f", " m/s")
+            lines.append(f"static divergence at V = {dv}" if dv else "no static divergence in the speeds searched")
+    elif any(k.startswith("fem.frequency_") for k in s):
+        parts = [f"{k[len('fem.frequency_'):-3].replace('_', '-', 1)} {_fmt(v, '.4f', ' Hz')}"
+                 for k, v in s.items() if k.startswith("fem.frequency_") and _fmt(v, ".4f")]
+        lines.append("first modes: " + ", ".join(parts))
+    elif "cable.horizontal_force_per_cable_N" in s:
+        lines.append(f"cable horizontal force H = {_fmt(s['cable.horizontal_force_per_cable_N'], '.4g', ' N')} "
+                     f"per cable, f_1 estimate (Eq 3.2) "
+                     f"{_fmt(s.get('cable.first_vertical_frequency_eq_3_2_hz'), '.4f', ' Hz')}")
+    return lines
+
+
+def _written_by_us(folder: Path) -> set[str]:
+    """Names of the files an earlier run wrote into ``folder``: its ``summary.json`` lists them under
+    ``run.files``; for a folder from a version before that list, its three fixed files and the plots
+    its ``report.md`` links to."""
+    try:
+        listed = json.loads((folder / "summary.json").read_text()).get("run.files")
+    except (OSError, ValueError, AttributeError):
+        return set()
+    if isinstance(listed, list):
+        return {n for n in listed if isinstance(n, str) and "/" not in n}
+    try:
+        report = (folder / "report.md").read_text()
+    except OSError:
+        report = ""
+    plots = set(re.findall(r"!\[[^\]]*\]\(([^)/]+\.png)\)", report))
+    return {"results.h5", "summary.json", "report.md"} | plots
+
+
+def check_target(out_root: Path, name: str, overwrite: bool) -> Path:
+    """The result folder ``out_root/name``; an InputError if it exists and ``overwrite`` is not set."""
+    final = Path(out_root) / name
+    if final.exists() and not overwrite:
+        raise InputError("--out", str(final), "already holds results of an earlier run; pass --overwrite to "
+                         "replace them (other files there are kept) or choose another --out")
+    if final.exists() and not final.is_dir():
+        raise InputError("--out", str(final), "is a file, not a result folder")
+    return final
+
+
+def _swap_into_place(tmp: Path, final: Path, new_files: set[str]) -> None:
+    """Replace ``final`` by ``tmp``, carrying over every entry of ``final`` that no run of ours wrote.
+
+    The earlier run's files go (this run's replace them); entries we did not write (a user's notes,
+    their own plots) move into the new folder first.  A clash between such an entry and a file of this
+    run is refused: a file that is not ours is never overwritten.  On any failure the earlier folder is
+    put back as it was.
+    """
+    if not final.exists():
+        os.replace(tmp, final)
+        return
+    ours = _written_by_us(final)
+    keep = [p for p in final.iterdir() if p.name not in ours]
+    clash = sorted(p.name for p in keep if p.name in new_files)
+    if clash:
+        raise InputError("--overwrite", str(final / clash[0]), "this file was not written by the program; "
+                         "move it away first (it would be replaced)")
+    moved: list[str] = []
+    old: Path | None = None
+    try:
+        for p in keep:
+            os.replace(p, tmp / p.name)
+            moved.append(p.name)
+        old = Path(tempfile.mkdtemp(prefix=f".{final.name}.", suffix=".old", dir=final.parent))
+        os.replace(final, old / "previous")
+        os.replace(tmp, final)
+    except BaseException:
+        if old is not None and not final.exists() and (old / "previous").exists():
+            os.replace(old / "previous", final)
+        for n in moved:  # the user's entries back where they were
+            if (tmp / n).exists():
+                os.replace(tmp / n, final / n)
+        if old is not None:
+            shutil.rmtree(old, ignore_errors=True)
+        raise
+    shutil.rmtree(old, ignore_errors=True)
+
+
+def write_results(out_root: Path, scenario: Scenario, outputs: Mapping[str, StageOutput],
+                  overwrite: bool = False, run_key: str | None = None) -> Path:
+    """Write all stage outputs of ``scenario`` to ``out_root/<scenario.name>/`` atomically; return that folder.
+
+    ``run_key`` (optional) is stored in ``summary.json`` as ``run.key``: the sweep uses it to tell a
+    finished case of the same inputs from one run with other inputs or stages.
+    """
+    from .cache import store
+
+    final = check_target(out_root, scenario.name, overwrite)
     out_root.mkdir(parents=True, exist_ok=True)
-    final = out_root / scenario.name
+    outputs = {name: store(out) for name, out in outputs.items()}  # figures rendered: nothing left to fail
     tmp = Path(tempfile.mkdtemp(prefix=f".{scenario.name}.", suffix=".tmp", dir=out_root))
     try:
         stamp = datetime.now(UTC).isoformat(timespec="seconds")
@@ -70,28 +204,29 @@ def write_results(out_root: Path, scenario: Scenario, outputs: Mapping[str, Stag
                 inputs.attrs[key] = value
             for name, out in outputs.items():
                 out.write_h5(h5.create_group(name))
-                summary.update({k: _summary_value(v) for k, v in out.summary.items()})
-        with open(tmp / "summary.json", "w") as fh:
-            json.dump(summary, fh, indent=2, sort_keys=False)
-            fh.write("\n")
-        report = [f"# {scenario.name}: results", "",
-                  f"{scenario.description}  ", f"Written {stamp} by bridge {__version__}; stages: "
-                  f"{', '.join(outputs)}.", ""]
+                summary.update(out.summary)
+        lines = headline(summary)
+        report = [f"# {scenario.name}: results", ""]
+        if lines:
+            report += ["**" + lines[0][0].upper() + lines[0][1:] + ".**  "] + [ln[0].upper() + ln[1:] + ".  "
+                                                                               for ln in lines[1:]] + [""]
+        report += [f"{scenario.description}  ", f"Written {stamp} by bridge {__version__}; stages: "
+                   f"{', '.join(outputs)}.  Details per stage follow.", ""]
         for out in outputs.values():
             report += [out.report.rstrip(), ""]
-            for fname, fig in out.figures.items():
-                fig.savefig(tmp / fname, dpi=120, bbox_inches="tight")
-                plt.close(fig)
+            for fname, png in out.figures.items():
+                (tmp / fname).write_bytes(png)
                 report += [f"![{fname}]({fname})", ""]
         (tmp / "report.md").write_text("\n".join(report))
-        os.chmod(tmp, 0o755)
-        if final.exists():
-            old = Path(tempfile.mkdtemp(prefix=f".{scenario.name}.", suffix=".old", dir=out_root))
-            os.replace(final, old / "previous")
-            os.replace(tmp, final)
-            shutil.rmtree(old, ignore_errors=True)
-        else:
-            os.replace(tmp, final)
+        files = sorted(p.name for p in tmp.iterdir()) + ["summary.json"]
+        summary["run.files"] = files
+        if run_key is not None:
+            summary["run.key"] = run_key
+        (tmp / "summary.json").write_text(summary_json(summary))
+        for p in tmp.iterdir():
+            os.chmod(p, file_mode())
+        os.chmod(tmp, folder_mode())
+        _swap_into_place(tmp, final, set(files))
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise

@@ -1,28 +1,30 @@
 """Command line: ``python -m bridge.scenario NAME_OR_PATH [NAME_OR_PATH ...] [options]``.
 
 Runs each scenario through its stages and writes ``OUT/<name>/`` (results.h5, summary.json, report.md,
-PNG plots).  With several scenarios it also writes ``OUT/comparison.md``: the bridges side by side.
-
-Exit status: 0 done; 2 bad input (one line naming the key, the value and the allowed range); 3 an
-iteration that did not converge (with its last residual).  Nothing half-written is left in OUT.
+PNG plots), then prints the headline (flutter speed, frequency, governing modes, multimode speed,
+divergence speed).  With several scenarios it also writes ``OUT/comparison.md``: the bridges side by side.
+Finished stages are kept in ``OUT/.cache/`` and reused while their inputs are unchanged.
 """
 
 from __future__ import annotations
 
 import argparse
-import os
+import signal
 import sys
-import tempfile
 import time
+import tomllib
 from collections.abc import Sequence
 from pathlib import Path
 
-from .config import load_scenario
+from . import __version__
+from .config import SCENARIO_DIR, load_scenario
 from .errors import ConvergenceError, InputError
-from .pipeline import run_scenario
+from .files import atomic_write_text, check_output_root
+from .pipeline import plan_stages, run_scenario
+from .results import check_target, headline
 from .stages import STAGES, RunOptions
 
-__all__ = ["main", "comparison_table"]
+__all__ = ["main", "comparison_table", "parse_stages", "EXIT_CODES", "Interrupts"]
 
 # Rows of the side-by-side table: (summary key, label, format).
 COMPARISON_ROWS = [
@@ -49,7 +51,15 @@ COMPARISON_ROWS = [
     ("fem.a_jk", "a_jk (Table 3.6)", "{:.3f}"),
     ("flutter.critical_speed_m_s", "flutter speed V_c [m/s]", "{:.1f}"),
     ("flutter.frequency_hz", "flutter frequency [Hz]", "{:.4f}"),
+    ("flutter.mode_pair", "governing mode pair", "{}"),
+    ("flutter.multimode_critical_speed_m_s", "multimode p-k V_c [m/s]", "{:.1f}"),
+    ("flutter.divergence_speed_m_s", "static divergence speed [m/s]", "{:.1f}"),
 ]
+
+EXIT_CODES = {0: "done",
+              2: "bad input: one line naming the key, the value and the allowed range; nothing written",
+              3: "an iteration did not converge (its last residual is printed)",
+              130: "interrupted (Ctrl-C); finished results and cached stages are kept"}
 
 
 def comparison_table(summaries: dict[str, dict]) -> str:
@@ -67,51 +77,140 @@ def comparison_table(summaries: dict[str, dict]) -> str:
     return "\n".join(lines)
 
 
+def _shipped_scenarios() -> str:
+    lines = []
+    for f in sorted(SCENARIO_DIR.glob("*.toml")):
+        try:
+            with open(f, "rb") as fh:
+                desc = tomllib.load(fh).get("description", "")
+        except (OSError, tomllib.TOMLDecodeError):
+            desc = ""
+        lines.append(f"  {f.stem:<26} {desc}")
+    return "\n".join(lines)
+
+
+def _epilog() -> str:
+    codes = "\n".join(f"  {k:<4} {v}" for k, v in EXIT_CODES.items())
+    return (f"shipped scenarios (scenarios/*.toml):\n{_shipped_scenarios()}\n\n"
+            f"exit status:\n{codes}\n\nresult schema: docs/results.md")
+
+
 def _parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="python -m bridge.scenario", description=__doc__.split("\n\n")[0],
-                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = argparse.ArgumentParser(prog="python -m bridge.scenario", description=__doc__.split("\n\n")[1],
+                                epilog=_epilog(), formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("scenarios", nargs="+", metavar="NAME_OR_PATH",
-                   help="scenario name in scenarios/ (great_belt, model_a, model_b, model_c) or a path to a .toml")
+                   help="a shipped scenario (listed below) or a path to a .toml file")
     p.add_argument("--out", default="out", type=Path, help="output folder (default: out/)")
     p.add_argument("--stages", default=None,
-                   help=f"comma-separated stages to run (known: {', '.join(STAGES)}; default: all for the kind)")
+                   help=f"comma-separated stages to run (known: {', '.join(STAGES)}; default: all for the kind); "
+                        "the stages they need run too, or come from the cache")
     p.add_argument("--main-span", type=float, default=None, metavar="METRES",
                    help="up-scale the bridge to this main span (thesis 1.5 rules)")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace the results of an earlier run in OUT/<name>/ (other files there are kept)")
+    p.add_argument("--no-cache", action="store_true",
+                   help="compute every stage afresh (and do not store them in OUT/.cache/)")
     p.add_argument("--quick", action="store_true", help="coarse meshes/grids: a fast smoke run")
     p.add_argument("--quiet", action="store_true", help="no progress messages")
+    p.add_argument("--version", action="version", version=f"bridge-flutter {__version__}")
     return p
+
+
+def parse_stages(text: str | None) -> list[str] | None:
+    """``--stages`` as a list (None: the default for each kind); an empty list is an InputError."""
+    if text is None:
+        return None
+    stages = [s.strip() for s in text.split(",") if s.strip()]
+    if not stages:
+        raise InputError("--stages", text, f"names no stage; known: {', '.join(STAGES)}")
+    return stages
+
+
+class Interrupts:
+    """Ctrl-C as one line and exit status 130, wherever it lands.
+
+    While active, SIGINT sets ``fired`` before raising KeyboardInterrupt, so an exception that the
+    interrupt caused elsewhere (a library turning it into an ImportError half-way through an import,
+    say) is still reported as the interruption it was.
+    """
+
+    def __init__(self):
+        self.fired = False
+        self._previous = None
+
+    def _handler(self, signum, frame):
+        self.fired = True
+        raise KeyboardInterrupt
+
+    def __enter__(self):
+        try:
+            self._previous = signal.signal(signal.SIGINT, self._handler)
+        except ValueError:  # not the main thread (e.g. called from a worker): leave SIGINT alone
+            self._previous = None
+        return self
+
+    def __exit__(self, *exc):
+        if self._previous is not None:
+            signal.signal(signal.SIGINT, self._previous)
+        return False
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     say = (lambda m: None) if args.quiet else (lambda m: print(m, file=sys.stderr, flush=True))
-    options = RunOptions(quick=args.quick, progress=say)
-    stages = None if args.stages is None else [s.strip() for s in args.stages.split(",") if s.strip()]
-    try:
-        # read and check every scenario before running any, so bad input costs nothing
-        scenarios = [load_scenario(n, main_span_m=args.main_span) for n in args.scenarios]
-        summaries = {}
-        for sc in scenarios:
-            t0 = time.perf_counter()
-            folder, outputs = run_scenario(sc, args.out, stages, options)
-            summary = {k: v for out in outputs.values() for k, v in out.summary.items()}
-            summaries[sc.name] = summary
-            say(f"[{sc.name}] done in {time.perf_counter() - t0:.1f} s -> {folder}")
-        if len(summaries) > 1:
-            table = comparison_table(summaries)
-            fd, tmp = tempfile.mkstemp(dir=args.out, prefix=".comparison.", suffix=".md")
-            with os.fdopen(fd, "w") as fh:
-                fh.write("# Bridges side by side\n\n" + table + "\n")
-            os.replace(tmp, Path(args.out) / "comparison.md")
-            print(table)
-        else:
-            print(f"results in {Path(args.out) / scenarios[0].name}")
-    except InputError as err:
-        print(f"error: {err}", file=sys.stderr)
-        return 2
-    except ConvergenceError as err:
-        print(f"error: {err}", file=sys.stderr)
-        return 3
+    written: list[Path] = []
+    with Interrupts() as interrupts:
+        try:
+            return _run(args, say, written)
+        except InputError as err:
+            print(f"error: {err}", file=sys.stderr)
+            return 2
+        except ConvergenceError as err:
+            print(f"error: {err}", file=sys.stderr)
+            return 3
+        except BaseException:
+            if not interrupts.fired:
+                raise
+            kept = f"kept: {', '.join(map(str, written))}" if written else "no result folder written"
+            cache = "" if args.no_cache else f"; finished stages stay in {args.out / '.cache'}"
+            print(f"interrupted; {kept}{cache}", file=sys.stderr)
+            return 130
+
+
+def _run(args: argparse.Namespace, say, written: list[Path]) -> int:
+    stages = parse_stages(args.stages)
+    # read and check everything before running anything, so bad input costs nothing
+    scenarios = [load_scenario(n, main_span_m=args.main_span) for n in args.scenarios]
+    seen: dict[str, str] = {}
+    for arg, sc in zip(args.scenarios, scenarios, strict=True):
+        if sc.name in seen:
+            raise InputError("name", sc.name, f"given to both {seen[sc.name]} and {arg}: each scenario of one "
+                             "command needs its own name (its result folder)")
+        seen[sc.name] = arg
+        plan_stages(sc, stages)
+    check_output_root(args.out)
+    for sc in scenarios:
+        check_target(args.out, sc.name, args.overwrite)
+    comparison = args.out / "comparison.md"
+    if len(scenarios) > 1 and comparison.exists() and not args.overwrite:
+        raise InputError("--out", str(comparison), "already holds a comparison of an earlier run; pass "
+                         "--overwrite to replace it or choose another --out")
+    options = RunOptions(quick=args.quick, progress=say, cache=None if args.no_cache else args.out / ".cache")
+    summaries = {}
+    for sc in scenarios:
+        t0 = time.perf_counter()
+        folder, outputs = run_scenario(sc, args.out, stages, options, overwrite=args.overwrite)
+        written.append(folder)
+        summaries[sc.name] = {k: v for out in outputs.values() for k, v in out.summary.items()}
+        say(f"[{sc.name}] done in {time.perf_counter() - t0:.1f} s -> {folder}")
+    for name, summary in summaries.items():
+        print(f"{name}: results in {args.out / name}")
+        for line in headline(summary):
+            print(f"  {line}")
+    if len(summaries) > 1:
+        table = comparison_table(summaries)
+        atomic_write_text(comparison, "# Bridges side by side\n\n" + table + "\n")
+        print(table)
     return 0
 
 

@@ -12,9 +12,10 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from importlib import import_module
+from pathlib import Path
 from typing import Any
 
-__all__ = ["StageOutput", "RunOptions", "STAGES", "resolve_stage"]
+__all__ = ["StageOutput", "RunOptions", "Stage", "STAGES", "IDENTITY_FIELDS", "resolve_stage"]
 
 
 @dataclass
@@ -22,15 +23,17 @@ class StageOutput:
     """Everything one stage produced.
 
     summary  - flat headline numbers for ``summary.json``; keys are ``"<stage>.<name>_<unit>"``,
-               e.g. ``"cable.horizontal_force_per_cable_N"``; values are float, int or str.
+               e.g. ``"cable.horizontal_force_per_cable_N"``; values are float, int, bool, str or None
+               (None: a number that does not exist, e.g. no flutter below the highest speed searched).
     write_h5 - callable that fills the stage's HDF5 group (``results.h5:/<stage>``); document every
                dataset in ``docs/results.md``.
     report   - a Markdown section for ``report.md`` (starts with a ``## `` heading).
-    figures  - ``{"file_name.png": matplotlib.figure.Figure}``.
+    figures  - ``{"file_name.png": matplotlib.figure.Figure}``, or PNG bytes once stored
+               (:func:`bridge.cache.store`).
     data     - the stage's Python result object, for later stages.
     """
 
-    summary: dict[str, float | int | str]
+    summary: dict[str, float | int | bool | str | None]
     write_h5: Callable[[Any], None]
     report: str
     figures: dict[str, Any] = field(default_factory=dict)
@@ -40,21 +43,46 @@ class StageOutput:
 @dataclass(frozen=True)
 class RunOptions:
     """Options of one run that are not physics: ``quick`` shrinks meshes/grids for tests and smoke runs;
-    ``progress`` is a callable taking a one-line message (default: print to stderr)."""
+    ``progress`` is a callable taking a one-line message (default: none); ``cache`` is the folder of the
+    stage cache (:mod:`bridge.cache`; None: compute every stage afresh and keep nothing)."""
 
     quick: bool = False
     progress: Callable[[str], None] | None = None
+    cache: Path | None = None
 
     def say(self, message: str) -> None:
         if self.progress is not None:
             self.progress(message)
 
 
-# Stage name -> ("module:function", stages it needs).  Order here is the run order.
-STAGES: dict[str, tuple[str, tuple[str, ...]]] = {
-    "cable": ("bridge.cable_stage:run", ()),
-    "fem": ("bridge.structure.stage:run", ("cable",)),
-    "flutter": ("bridge.flutter.stage:run", ("fem",)),
+@dataclass(frozen=True)
+class Stage:
+    """A registered stage.
+
+    target  - ``"module:function"`` of its ``run``
+    needs   - stages whose outputs it reads (``upstream``)
+    code    - modules and packages whose source decides its result: their text is part of the stage's
+              cache key (:mod:`bridge.cache`), so changed code never reuses an old result
+    ignores - top-level scenario fields its result does not depend on (also left out of the cache key:
+              changing the flutter options does not rerun the FEM)
+    """
+
+    target: str
+    needs: tuple[str, ...]
+    code: tuple[str, ...]
+    ignores: tuple[str, ...] = ()
+
+
+# The scenario fields that never change a result: how it is called and where it was read from.
+IDENTITY_FIELDS = ("description", "source_path")
+
+# Registry; the order here is the run order.
+STAGES: dict[str, Stage] = {
+    "cable": Stage("bridge.cable_stage:run", (), ("bridge.cable", "bridge.cable_stage"),
+                   ignores=("damping", "air", "flutter", "section", "modal")),
+    "fem": Stage("bridge.structure.stage:run", ("cable",), ("bridge.structure", "kernels.fem"),
+                 ignores=("air", "flutter", "section", "modal")),
+    "flutter": Stage("bridge.flutter.stage:run", ("fem",), ("bridge.flutter",)),
 }
 
 
@@ -62,6 +90,5 @@ def resolve_stage(name: str) -> Callable[..., StageOutput]:
     """Import the stage function registered under ``name``."""
     if name not in STAGES:
         raise KeyError(f"unknown stage {name!r}; known stages: {', '.join(STAGES)}")
-    target, _ = STAGES[name]
-    module_name, func_name = target.split(":")
+    module_name, func_name = STAGES[name].target.split(":")
     return getattr(import_module(module_name), func_name)

@@ -2,23 +2,28 @@
 
 Every combination of the listed main spans and ``--vary`` values is one case, run through the pipeline
 like ``python -m bridge.scenario`` and written to ``OUT/<sweep>/cases/<case>/``.  The sweep is resumable:
-a case whose folder is complete (results are renamed into place only when finished) is skipped.  Cases
+a case whose folder holds a finished run of the same inputs and stages is skipped (results are renamed
+into place only when finished).  Stages shared by cases (same inputs) come from the stage cache
+``OUT/.cache/`` (``--no-cache`` recomputes).  Cases
 run in parallel on local processes (``--workers``, default 2) or on an existing Dask cluster
 (``--scheduler tcp://host:8786``; needs the optional extra ``pip install -e ".[dask]"``).
 
 At the end ``OUT/<sweep>/sweep.h5`` holds one table (a dataset per numeric summary key, one row per case,
-plus the varied inputs) and ``OUT/<sweep>/sweep.png`` plots a chosen result (default the flutter speed,
+plus the varied inputs), ``OUT/<sweep>/sweep.csv`` the same table for a spreadsheet, and
+``OUT/<sweep>/sweep.png`` plots a chosen result (default the flutter speed,
 ``flutter.critical_speed_m_s``, when the flutter stage ran) against the main span.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import itertools
 import json
 import math
 import os
 import re
+import signal
 import sys
 import tempfile
 import time
@@ -73,22 +78,67 @@ def plan_cases(scenario: str, spans: Sequence[float] | None, vary: dict[str, lis
     return cases
 
 
-def run_case(case: Case, out_dir: str, stages: list[str] | None, quick: bool) -> tuple[str, str]:
-    """Run one case (in a worker process) and return (case name, "done" | "skipped" | error line)."""
+def case_key(case: Case, stages: list[str] | None, quick: bool) -> str:
+    """What a finished case must have been run with to be skipped on resume: the validated inputs of its
+    scenario, the planned stages, ``quick`` and the program version (SHA-256)."""
+    import hashlib
+
+    from . import __version__
+    from .config import scenario_fields
+    from .pipeline import plan_stages
+
+    sc = load_scenario(case.scenario, main_span_m=case.main_span_m, overrides=dict(case.overrides))
+    blob = json.dumps({"inputs": {k: v for k, v in scenario_fields(sc).items() if k not in ("name", "source_path")},
+                       "stages": list(plan_stages(sc, stages)), "quick": bool(quick), "version": __version__},
+                      sort_keys=True, default=repr)
+    return hashlib.sha256(blob.encode()).hexdigest()
+
+
+def _finished_with(folder: Path) -> str | None:
+    try:
+        return json.loads((folder / "summary.json").read_text()).get("run.key")
+    except (OSError, ValueError, AttributeError):
+        return None
+
+
+def _worker_start() -> None:
+    """Sweep worker processes leave Ctrl-C to the parent, which asks each running case to stop."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+def run_case(case: Case, out_dir: str, stages: list[str] | None, quick: bool,
+             cache_dir: str | None = None) -> tuple[str, str]:
+    """Run one case (in a worker process) and return (case name, "done" | "skipped" | "interrupted" |
+    error line).  A case is skipped only if its folder holds a finished run of the same inputs and
+    stages (:func:`case_key`); a folder from other inputs is replaced (files the program did not
+    write stay)."""
     from dataclasses import replace
 
     from .pipeline import run_scenario
     from .stages import RunOptions
 
-    folder = Path(out_dir) / case.name
-    if (folder / "summary.json").is_file():
-        return case.name, "skipped"
+    previous = signal.getsignal(signal.SIGINT)
+    in_worker = previous is signal.SIG_IGN
+    if in_worker:  # a running case stops on Ctrl-C (the parent forwards it), cleaning up after itself
+        signal.signal(signal.SIGINT, signal.default_int_handler)
     try:
+        key = case_key(case, stages, quick)
+        folder = Path(out_dir) / case.name
+        if _finished_with(folder) == key:
+            return case.name, "skipped"
         sc = load_scenario(case.scenario, main_span_m=case.main_span_m, overrides=dict(case.overrides))
         sc = replace(sc, name=case.name)
-        run_scenario(sc, Path(out_dir), stages, RunOptions(quick=quick))
+        run_scenario(sc, Path(out_dir), stages, RunOptions(quick=quick, cache=Path(cache_dir) if cache_dir else None),
+                     overwrite=True, run_key=key)
     except (InputError, ConvergenceError) as err:
         return case.name, f"error: {err}"
+    except KeyboardInterrupt:
+        if not in_worker:
+            raise
+        return case.name, "interrupted"
+    finally:
+        if in_worker:
+            signal.signal(signal.SIGINT, signal.SIG_IGN)
     return case.name, "done"
 
 
@@ -96,9 +146,23 @@ def _as_float(value: Any) -> float:
     return float(value) if isinstance(value, (int, float)) and not isinstance(value, bool) else np.nan
 
 
+def _label(key: str) -> str:
+    """Axis label of a summary key: the comparison table's label where it has one, else the key."""
+    from .scenario import COMPARISON_ROWS
+
+    return next((label for k, label, _ in COMPARISON_ROWS if k == key), key)
+
+
 def collect(cases: list[Case], cases_dir: Path, sweep_dir: Path, plot_key: str | None) -> Path:
-    """Gather every finished case's summary into ``sweep.h5`` and plot ``plot_key`` against the main span."""
+    """Gather every finished case's summary into ``sweep.h5`` and ``sweep.csv`` and plot ``plot_key``
+    against the main span (``sweep.png``).  A ``plot_key`` that is no numeric result of any finished
+    case is an InputError, raised before anything is written."""
+    import csv
+    import io
+
     import h5py
+
+    from .files import atomic_write_bytes, atomic_write_text, file_mode
 
     rows = []
     for c in cases:
@@ -106,63 +170,91 @@ def collect(cases: list[Case], cases_dir: Path, sweep_dir: Path, plot_key: str |
         rows.append(json.loads(f.read_text()) if f.is_file() else None)
     numeric = sorted({k for r in rows if r for k, v in r.items()
                       if isinstance(v, (int, float)) and not isinstance(v, bool)})
+    if plot_key is not None and plot_key not in numeric:
+        shown = ", ".join(numeric[:12]) + (", ..." if len(numeric) > 12 else "")
+        raise InputError("--plot", plot_key, f"not a numeric result of this sweep; available: {shown or 'none'}")
+    varied = sorted({k for c in cases for k, _ in c.overrides})
     fd, tmp = tempfile.mkstemp(dir=sweep_dir, prefix=".sweep.", suffix=".h5")
     os.close(fd)
-    with h5py.File(tmp, "w") as h5:
-        h5.attrs["description"] = "one row per case; NaN where a case failed or lacks the quantity"
-        h5.create_dataset("case", data=np.array([c.name for c in cases], dtype=h5py.string_dtype()))
-        h5.create_dataset("finished", data=np.array([r is not None for r in rows]))
-        inputs = h5.create_group("inputs")
-        inputs.create_dataset("main_span_m", data=np.array(
-            [np.nan if c.main_span_m is None else c.main_span_m for c in cases]))
-        for key in {k for c in cases for k, _ in c.overrides}:
-            vals = [dict(c.overrides).get(key) for c in cases]
-            if all(isinstance(v, (int, float)) for v in vals):
-                inputs.create_dataset(key, data=np.array(vals, dtype=float))
-            else:
-                inputs.create_dataset(key, data=np.array([str(v) for v in vals], dtype=h5py.string_dtype()))
-        results = h5.create_group("results")
-        for key in numeric:  # "none" (e.g. no flutter for a pair) and missing values become NaN
-            results.create_dataset(key, data=np.array([_as_float(r.get(key)) if r else np.nan for r in rows]))
-    os.replace(tmp, sweep_dir / "sweep.h5")
+    try:
+        with h5py.File(tmp, "w") as h5:
+            h5.attrs["description"] = "one row per case; NaN where a case failed or lacks the quantity"
+            h5.create_dataset("case", data=np.array([c.name for c in cases], dtype=h5py.string_dtype()))
+            h5.create_dataset("finished", data=np.array([r is not None for r in rows]))
+            inputs = h5.create_group("inputs")
+            inputs.create_dataset("main_span_m", data=np.array(
+                [np.nan if c.main_span_m is None else c.main_span_m for c in cases]))
+            for key in varied:
+                vals = [dict(c.overrides).get(key) for c in cases]
+                if all(isinstance(v, (int, float)) for v in vals):
+                    inputs.create_dataset(key, data=np.array(vals, dtype=float))
+                else:
+                    inputs.create_dataset(key, data=np.array([str(v) for v in vals], dtype=h5py.string_dtype()))
+            results = h5.create_group("results")
+            for key in numeric:  # null (e.g. no flutter for a pair) and missing values become NaN
+                results.create_dataset(key, data=np.array([_as_float(r.get(key)) if r else np.nan for r in rows]))
+        os.chmod(tmp, file_mode())
+        os.replace(tmp, sweep_dir / "sweep.h5")
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+    text = io.StringIO()
+    w = csv.writer(text, lineterminator="\n")
+    w.writerow(["case", "finished", "main_span_m", *varied, *numeric])
+    for c, r in zip(cases, rows, strict=True):
+        over = dict(c.overrides)
+        w.writerow([c.name, r is not None, "" if c.main_span_m is None else c.main_span_m,
+                    *(over.get(k, "") for k in varied),
+                    *("" if not r or math.isnan(_as_float(r.get(k))) else r.get(k) for k in numeric)])
+    atomic_write_text(sweep_dir / "sweep.csv", text.getvalue())
 
     if plot_key is None:
         plot_key = next((k for k in ("flutter.critical_speed_m_s", "fem.frequency_S_V1_hz",
                                      "cable.horizontal_force_total_N") if k in numeric), None)
-    if plot_key is not None and plot_key in numeric:
+    if plot_key is not None:
         import matplotlib
 
         matplotlib.use("Agg")
         from matplotlib.figure import Figure
 
-        fig = Figure(figsize=(6, 4))
+        fig = Figure(figsize=(6.4, 4.2), layout="constrained")
         ax = fig.subplots()
         spans = [r.get("scenario.main_span_m", np.nan) if r else np.nan for r in rows]
         ys = [_as_float(r.get(plot_key)) if r else np.nan for r in rows]
-        labels = sorted({tuple(c.overrides) for c in cases})
+        labels = sorted({tuple(c.overrides) for c in cases}, key=repr)
         for lab in labels:
             idx = [i for i, c in enumerate(cases) if tuple(c.overrides) == lab]
             order = sorted(idx, key=lambda i: spans[i])
-            text = ", ".join(f"{k}={v}" for k, v in lab) or Path(cases[0].scenario).stem
-            ax.plot([spans[i] for i in order], [ys[i] for i in order], "o-", label=text)
+            text_label = ", ".join(f"{k} = {v}" for k, v in lab) or Path(cases[0].scenario).stem
+            ax.plot([spans[i] for i in order], [ys[i] for i in order], "o-", label=text_label)
         ax.set_xlabel("main span L [m]")
-        ax.set_ylabel(plot_key)
+        ax.set_ylabel(_label(plot_key))
+        ax.set_title(f"{sweep_dir.name}: {_label(plot_key).split(' [')[0]} against main span", fontsize=10)
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
-        fd, tmp_png = tempfile.mkstemp(dir=sweep_dir, prefix=".sweep.", suffix=".png")
-        os.close(fd)
-        fig.savefig(tmp_png, dpi=120, bbox_inches="tight")
-        os.replace(tmp_png, sweep_dir / "sweep.png")
+        buf = io.BytesIO()
+        fig.savefig(buf, format="png", dpi=120)
+        atomic_write_bytes(sweep_dir / "sweep.png", buf.getvalue())
     return sweep_dir / "sweep.h5"
 
 
 def run_sweep(cases: list[Case], sweep_dir: Path, stages: list[str] | None = None, quick: bool = False,
-              workers: int = 2, scheduler: str | None = None, say=print) -> dict[str, str]:
-    """Run all cases (skipping finished ones) locally or on a Dask cluster; return case -> status."""
+              workers: int = 2, scheduler: str | None = None, say=print,
+              cache_dir: Path | None = None) -> dict[str, str]:
+    """Run all cases (skipping finished ones) locally or on a Dask cluster; return case -> status.
+
+    ``cache_dir``: the stage cache shared by the cases (:mod:`bridge.cache`; None: no cache).  On Ctrl-C
+    the running cases are asked to stop (each cleans up after itself), the ones not started are
+    cancelled, and KeyboardInterrupt is raised with the finished cases in place.
+    """
+    import multiprocessing
+
     cases_dir = sweep_dir / "cases"
     cases_dir.mkdir(parents=True, exist_ok=True)
     status: dict[str, str] = {}
     t0 = time.perf_counter()
+    cache = None if cache_dir is None else str(cache_dir)
 
     def report(name: str, state: str) -> None:
         status[name] = state
@@ -174,7 +266,8 @@ def run_sweep(cases: list[Case], sweep_dir: Path, stages: list[str] | None = Non
         except ImportError:
             raise InputError("--scheduler", scheduler, 'needs Dask: pip install -e ".[dask]"') from None
         client = Client(scheduler)
-        futures = client.map(run_case, cases, out_dir=str(cases_dir), stages=stages, quick=quick, pure=False)
+        futures = client.map(run_case, cases, out_dir=str(cases_dir), stages=stages, quick=quick,
+                             cache_dir=cache, pure=False)
         from distributed import as_completed as dask_completed
 
         for fut in dask_completed(futures):
@@ -182,17 +275,30 @@ def run_sweep(cases: list[Case], sweep_dir: Path, stages: list[str] | None = Non
         client.close()
     elif workers <= 1:
         for c in cases:
-            report(*run_case(c, str(cases_dir), stages, quick))
+            report(*run_case(c, str(cases_dir), stages, quick, cache))
     else:
-        with ProcessPoolExecutor(max_workers=workers) as pool:
-            futs = [pool.submit(run_case, c, str(cases_dir), stages, quick) for c in cases]
+        pool = ProcessPoolExecutor(max_workers=workers, initializer=_worker_start)
+        try:
+            futs = [pool.submit(run_case, c, str(cases_dir), stages, quick, cache) for c in cases]
             for fut in as_completed(futs):
                 report(*fut.result())
+        except KeyboardInterrupt:
+            for f in futs:
+                f.cancel()
+            for child in multiprocessing.active_children():  # a Ctrl-C sent to us alone reaches them too
+                if child.pid is not None:
+                    with contextlib.suppress(OSError):
+                        os.kill(child.pid, signal.SIGINT)
+            pool.shutdown(wait=True, cancel_futures=True)
+            raise
+        pool.shutdown(wait=True)
     return status
 
 
 def _parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="python -m bridge.sweep", description=__doc__.split("\n\n")[0])
+    p = argparse.ArgumentParser(prog="python -m bridge.sweep", description=__doc__.split("\n\n")[0],
+                                epilog="exit status: 0 done; 1 some cases failed (listed); 2 bad input, nothing "
+                                       "run; 130 interrupted (finished cases kept)")
     p.add_argument("scenario", help="scenario name or path (the base of every case)")
     p.add_argument("--main-span", default=None, help="comma-separated main spans in metres")
     p.add_argument("--vary", action="append", default=[], metavar="KEY=V1,V2",
@@ -204,46 +310,69 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--workers", type=int, default=min(2, os.cpu_count() or 1), help="local processes")
     p.add_argument("--scheduler", default=None, help="address of an existing Dask scheduler")
     p.add_argument("--plot", default=None, help="summary key to plot against the main span")
+    p.add_argument("--no-cache", action="store_true", help="compute every stage afresh (no OUT/.cache/)")
     p.add_argument("--quick", action="store_true", help="coarse meshes/grids")
     return p
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    from .files import check_output_root
+    from .pipeline import plan_stages
+    from .scenario import Interrupts, parse_stages
+
     args = _parser().parse_args(argv)
     say = lambda m: print(m, file=sys.stderr, flush=True)  # noqa: E731
-    try:
-        spans = None
-        if args.main_span:
-            spans = []
-            for x in args.main_span.split(","):
-                try:
-                    v = float(x)
-                except ValueError:
-                    raise InputError("--main-span", x, "must be numbers separated by commas") from None
-                if not (math.isfinite(v) and v > 0):
-                    raise InputError("--main-span", x, "must be positive")
-                spans.append(v)
-        vary: dict[str, list[Any]] = {}
-        for item in args.vary:
-            if "=" not in item:
-                raise InputError("--vary", item, "must be KEY=V1,V2,...")
-            key, values = item.split("=", 1)
-            vary[key.strip()] = [_parse_value(v.strip()) for v in values.split(",") if v.strip()]
-        cases = plan_cases(args.scenario, spans, vary)
-        for c in cases:  # check every case's input before running any
-            load_scenario(c.scenario, main_span_m=c.main_span_m, overrides=dict(c.overrides))
-        stages = None if args.stages is None else [s.strip() for s in args.stages.split(",") if s.strip()]
-        sweep_dir = args.out / (args.name or f"sweep_{Path(args.scenario).stem}")
-        status = run_sweep(cases, sweep_dir, stages, args.quick, args.workers, args.scheduler, say)
-        table = collect(cases, sweep_dir / "cases", sweep_dir, args.plot)
-        failed = {k: v for k, v in status.items() if v.startswith("error")}
-        print(f"sweep table: {table}")
-        for k, v in failed.items():
-            print(f"{k}: {v}", file=sys.stderr)
-        return 1 if failed else 0
-    except InputError as err:
-        print(f"error: {err}", file=sys.stderr)
-        return 2
+    sweep_dir = None
+    with Interrupts() as interrupts:
+        try:
+            spans = None
+            if args.main_span:
+                spans = []
+                for x in args.main_span.split(","):
+                    try:
+                        v = float(x)
+                    except ValueError:
+                        raise InputError("--main-span", x, "must be numbers separated by commas") from None
+                    if not (math.isfinite(v) and v > 0):
+                        raise InputError("--main-span", x, "must be positive")
+                    spans.append(v)
+            vary: dict[str, list[Any]] = {}
+            for item in args.vary:
+                if "=" not in item:
+                    raise InputError("--vary", item, "must be KEY=V1,V2,...")
+                key, values = item.split("=", 1)
+                vary[key.strip()] = [_parse_value(v.strip()) for v in values.split(",") if v.strip()]
+                if not vary[key.strip()]:
+                    raise InputError("--vary", item, "needs at least one value after '='")
+            stages = parse_stages(args.stages)
+            cases = plan_cases(args.scenario, spans, vary)
+            planned: set[str] = set()
+            for c in cases:  # check every case's input and stages before running any
+                sc = load_scenario(c.scenario, main_span_m=c.main_span_m, overrides=dict(c.overrides))
+                planned |= set(plan_stages(sc, stages))
+            if args.plot is not None and args.plot.split(".")[0] not in planned | {"scenario"}:
+                raise InputError("--plot", args.plot, f"names no result of the stages this sweep runs "
+                                 f"({', '.join(sorted(planned))}); keys look like flutter.critical_speed_m_s")
+            check_output_root(args.out)
+            sweep_dir = args.out / (args.name or f"sweep_{Path(args.scenario).stem}")
+            status = run_sweep(cases, sweep_dir, stages, args.quick, args.workers, args.scheduler, say,
+                               cache_dir=None if args.no_cache else args.out / ".cache")
+            table = collect(cases, sweep_dir / "cases", sweep_dir, args.plot)
+            failed = {k: v for k, v in status.items() if v.startswith("error")}
+            print(f"sweep table: {table} (also {table.with_suffix('.csv').name}, "
+                  f"{'sweep.png' if (sweep_dir / 'sweep.png').is_file() else 'no plot'})")
+            for k, v in failed.items():
+                print(f"{k}: {v}", file=sys.stderr)
+            return 1 if failed else 0
+        except InputError as err:
+            print(f"error: {err}", file=sys.stderr)
+            return 2
+        except BaseException:
+            if not interrupts.fired:
+                raise
+            where = f" in {sweep_dir / 'cases'}" if sweep_dir is not None else ""
+            print(f"interrupted; finished cases are kept{where} (the same command resumes)", file=sys.stderr)
+            return 130
 
 
 if __name__ == "__main__":

@@ -62,6 +62,9 @@ class RowLauncher:
     MAX_RECORDS = 256  # least recently used records beyond this are dropped
 
     def __init__(self, device: str | None = None, threads: int = 2, record: bool = True):
+        from ..warp_setup import init_warp
+
+        init_warp("cpu" if device is None else str(device))
         self.device = wp.get_device(device)
         if threads < 1:
             raise ValueError(f"threads: must be >= 1, got {threads}")

@@ -51,24 +51,15 @@ class ElementSet:
         return len(self.xa)
 
 
-_warp_ready = False
+def _warp(device: str = "cpu"):
+    from ..warp_setup import init_warp
 
-
-def _warp():
-    global _warp_ready
-    import warp as wp
-
-    if not _warp_ready:
-        import kernels  # noqa: F401  (sets Warp's log level before its start-up banner)
-
-        wp.init()
-        _warp_ready = True
-    return wp
+    return init_warp(device)
 
 
 def element_matrices(elements: ElementSet, device: str = "cpu") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Global (K_elastic, M_consistent, K_geometric), each (n, 12, 12) float64, from the Warp kernel."""
-    wp = _warp()
+    wp = _warp(device)
     from kernels import fem
 
     n = len(elements)
