@@ -1,7 +1,8 @@
 """Cable statics of a three-span suspension bridge under dead load (thesis chapter 2).
 
-Per cable (SPEC section 2): each of the two main cables carries half the girder, ``w_b = mu_b / 2``, plus
-its own weight along its arc.  With y up and H the (constant) horizontal cable force,
+Per cable (the reading of thesis Eq 2.3 in docs/thesis_errata.md): each of the two main cables carries
+half the girder, ``w_b = mu_b / 2``, plus its own weight along its arc.  With y up and H the (constant)
+horizontal cable force,
 
     H y'' = g (w_b + mu_c sqrt(1 + y'^2))                                            (Eq 2.3)
 
@@ -187,7 +188,7 @@ def solve_cables(scenario: Scenario, steps_per_panel: int = 8, tolerance: float 
         raise InputError("kind", scenario.kind, "cable statics need a suspension_bridge scenario")
     geo, cab, g = scenario.geometry, scenario.cable, GRAVITY_M_S2
     span, side, sag = geo.main_span_m, geo.side_span_m, geo.sag_m
-    w_b = 0.5 * scenario.girder.mass_per_length_kg_m  # per cable, SPEC section 2
+    w_b = 0.5 * scenario.girder.mass_per_length_kg_m  # per cable, docs/thesis_errata.md
     mu_c, mu_cs = cab.mass_per_length_main_kg_m, cab.mass_per_length_side_kg_m
 
     n_main = panel_count(span, geo.hanger_spacing_target_m, even=True)

@@ -7,7 +7,7 @@ ghost layers; cell (i, j) is stored at (J, I) = (j + G, i + G); the u-face at st
 LEFT face of cell column I; the v-face at storage (J, I) is the BOTTOM face of cell row J.
 
 Kernel shape: one thread per row with an inner loop over the columns (2x faster on the CPU backend
-than a 2D ``wp.tid()``; see WARP_CPU.md); ``row0`` lets the launcher split the rows over threads.
+than a 2D ``wp.tid()``; see docs/warp_cpu.md); ``row0`` lets the launcher split the rows over threads.
 Every kernel also runs unchanged on "cuda" (one thread per row there too).
 
 Kernels are typed for float64 (the project's CFD precision, ``bridge.cfd.precision``).
@@ -560,7 +560,7 @@ def tridiag_columns(r: wp.array2d(dtype=wp.float64), scale: wp.array(dtype=wp.fl
     Column k solves lower[j] x[j-1] + d[j, k] x[j] + upper[j, k] x[j+1] = scale[j] r[j, k] with the
     factorisation precomputed (``cprime`` = upper / denom, ``inv_denom`` = 1 / denom); thread index
     b (+ ``row0``, the launcher's chunk offset) owns columns [b block, (b+1) block), so that each
-    row of a block is a contiguous inner loop (WARP_CPU.md: row loops, no 2D tid)."""
+    row of a block is a contiguous inner loop (docs/warp_cpu.md: row loops, no 2D tid)."""
     b = row0 + wp.tid()
     ny = r.shape[0]
     k0 = b * block

@@ -1,4 +1,4 @@
-"""Validation of the laminar CFD core against published numbers (VALIDATION.md); not in the test run.
+"""Validation of the laminar CFD core against published numbers (docs/reference_cases.md); not in the test run.
 
     python tools/validate_cfd.py cylinder --re 20 --ppd 20 30 --t-end 40
     python tools/validate_cfd.py cylinder --re 100 --ppd 20 --t-end 150
@@ -55,7 +55,7 @@ from bridge.cfd import (  # noqa: E402
 )
 from bridge.cfd.advection import SCHEMES  # noqa: E402
 
-BANDS = {  # VALIDATION.md
+BANDS = {  # docs/reference_cases.md
     20: {"C_D": (2.00, 2.09), "L_w/D": (0.91, 0.94)},
     40: {"C_D": (1.50, 1.58), "L_w/D": (2.13, 2.35)},
     100: {"St": (0.160, 0.168), "C_D": (1.33, 1.40)},

@@ -3,7 +3,7 @@
 Geometry only: area, centroid and polar second moment (needed by the internal-fluid correction of the
 immersed-boundary force), and factories for the shapes of the project: circle, thin plate, and a
 streamlined box-girder deck (a parametric hexagon: the thesis's drawings are not available, so the
-shape is defined by width B, depth D and the fairing nose/tail lengths; SPEC section 5).
+shape is defined by width B, depth D and the fairing nose/tail lengths; docs/thesis_errata.md).
 """
 
 from __future__ import annotations

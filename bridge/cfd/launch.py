@@ -1,6 +1,6 @@
 """Row-kernel launcher: splits the rows of a launch over CPU threads (the CPU backend runs one
 launch on one thread; two Python threads launching over half the rows each use both cores, with
-identical results, WARP_CPU.md). On CUDA a launch covers all rows at once (no splitting).
+identical results, docs/warp_cpu.md). On CUDA a launch covers all rows at once (no splitting).
 
 Launches are recorded once and replayed: a plain ``wp.launch`` packs every argument again (~30-50 us
 for the solver's 20-argument kernels, ~1.3 ms per time step), a recorded ``Launch`` replays in

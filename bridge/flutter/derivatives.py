@@ -13,7 +13,7 @@ The moment is taken about the mid-chord (the deck's centre line) in both.
 Substituting hdot = i w h = i (K U / B) h and u = -h, p = -L, theta = alpha, m = M:
     h_pu     =  K^2 (H4* + i H1*)        h_ptheta = -K^2 (H3* + i H2*)
     h_mu     = -K^2 (A4* + i A1*)        h_mtheta =  K^2 (A3* + i A2*)
-(so with h and L positive UP, H2*, H3*, A1*, A4* change sign, as VALIDATION.md states).
+(so with h and L positive UP, H2*, H3*, A1*, A4* change sign; Scanlan and Tomko 1971, docs/reference_cases.md).
 """
 
 from __future__ import annotations

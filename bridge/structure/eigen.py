@@ -1,9 +1,10 @@
 """Generalised eigenproblem K phi = omega^2 M phi by shift-invert Lanczos (scipy ARPACK).
 
 The operator (K - sigma M)^-1 is given to ``eigsh`` as ``OPinv`` from one sparse LU factorisation
-(``splu``), as WARP_CPU.md recommends; sigma is slightly negative so that the factorisation stays
-non-singular even if the model had a mechanism (a rigid-body mode would then appear at ~0 Hz and be
-visible rather than crash the factorisation).  M may be semi-definite (shift-invert mode allows it).
+(``splu``), scipy's shift-invert mode (timings in docs/warp_cpu.md); sigma is slightly negative so that
+the factorisation stays non-singular even if the model had a mechanism (a rigid-body mode would then
+appear at ~0 Hz and be visible rather than crash the factorisation).  M may be semi-definite
+(shift-invert mode allows it).
 """
 
 from __future__ import annotations

@@ -3,7 +3,7 @@
 Coordinates as in thesis 3.1 / Fig 3.1: z along the bridge (0 at the left anchor, the girder end),
 y up (0 at the pylon foundations), x across.  Units SI.
 
-What is modelled (thesis 3.1-3.2, SPEC section 3):
+What is modelled (thesis 3.1-3.2; readings in docs/thesis_errata.md):
 * Two main cables at x = +-B_c/2 (B_c = geometry.cable_plane_spacing_m) through the cable statics
   solution (:mod:`bridge.cable`): anchors (z = 0 and z = L_tot) to the pylon tops and across the main
   span, one node per hanger plus ``n_sub - 1`` intermediate nodes per hanger panel.  Panel points

@@ -1,5 +1,5 @@
 """Immersed-boundary forces: a body carried with the stream feels nothing, a body at rest feels a
-symmetric drag, an accelerating body feels the added mass of potential theory (VALIDATION.md)."""
+symmetric drag, an accelerating body feels the added mass of potential theory (docs/reference_cases.md)."""
 
 import numpy as np
 import pytest
@@ -155,7 +155,7 @@ def test_rotating_cylinder_feels_only_a_resisting_torque():
 
 
 def test_dfg_pressure_difference_at_d16():
-    """DFG benchmark 2D-1 (Schaefer and Turek 1996; VALIDATION.md): p(0.15, 0.2) - p(0.25, 0.2) =
+    """DFG benchmark 2D-1 (Schaefer and Turek 1996; docs/reference_cases.md): p(0.15, 0.2) - p(0.25, 0.2) =
     0.11752, c_D = 5.5795 on the cylinder in the channel, here at the coarse h = D/16 to t = 4 (the
     flow is steady by then to 1e-3). Checks that the pressure next to an immersed wall is the wall
     pressure: before the forced faces were compensated for the projection the difference was 0.141

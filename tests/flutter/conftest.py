@@ -21,7 +21,7 @@ def plate_section(frequency_ratio: float, mass_ratio: float, radius_ratio: float
 
 def selberg_speed(model: ModalModel, rho: float = RHO) -> float:
     """Selberg (1961): U_F = 0.44 B w_a sqrt((1 - (w_h/w_a)^2) sqrt(nu) / mu), nu = 8 r^2/B^2,
-    mu = pi rho B^2 / (2 m), r^2 = I/m (VALIDATION.md)."""
+    mu = pi rho B^2 / (2 m), r^2 = I/m (docs/reference_cases.md)."""
     B, m, I = model.deck_width_m, model.mass_per_length_kg_m, model.inertia_per_length_kg_m2_m
     wh, wa = model.angular_frequencies
     nu = 8 * (I / m) / B**2

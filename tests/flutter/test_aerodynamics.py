@@ -1,7 +1,7 @@
 """Aerodynamic models and the h_xy <-> Scanlan conversions.
 
 Sources: Theodorsen (1935), NACA Report 496 (C(k) and the plate forces); Scanlan and Tomko (1971)
-(flutter derivatives); the check values are those of /work/shared/reference/VALIDATION.md.
+(flutter derivatives); the check values are collected in docs/reference_cases.md.
 """
 
 import numpy as np
@@ -20,7 +20,7 @@ def test_theodorsen_function_matches_published_values(k, expected):
 
 
 def _closed_forms(K):
-    """Scanlan-form Theodorsen derivatives as printed in VALIDATION.md (h, L positive down)."""
+    """Scanlan-form Theodorsen derivatives as printed in docs/reference_cases.md (h, L positive down)."""
     C = theodorsen_function(K / 2)
     F, G = C.real, C.imag
     pi = np.pi
@@ -40,7 +40,7 @@ def test_direct_theodorsen_frf_equals_closed_form_derivatives_after_conversion()
         np.testing.assert_allclose(getattr(d, name), getattr(ref, name), rtol=1e-12, atol=1e-12, err_msg=name)
 
 
-CHECK_TABLE = {  # U/(fB): H1* H2* H3* H4* A1* A2* A3* A4*  (VALIDATION.md)
+CHECK_TABLE = {  # U/(fB): H1* H2* H3* H4* A1* A2* A3* A4*  (docs/reference_cases.md)
     4: (-2.222, -1.255, -1.533, 1.099, 0.556, -0.186, 0.432, 0.118),
     8: (-5.019, -1.563, -6.723, 0.242, 1.255, -0.609, 1.730, 0.332),
     12: (-8.226, -0.839, -16.26, -0.637, 2.056, -1.290, 4.115, 0.552),
@@ -87,7 +87,7 @@ def test_conversion_round_trip_is_identity():
 
 
 def test_sign_convention_flips_exactly_four_derivatives():
-    # VALIDATION.md: with h and L positive UP, H2*, H3*, A1*, A4* change sign.  Build h_xy from a set of
+    # docs/reference_cases.md: with h and L positive UP, H2*, H3*, A1*, A4* change sign.  Build h_xy from a set of
     # derivatives, flip the heave axis (u -> -u, p -> -p) by hand, and read the derivatives again.
     K = np.array([0.7])
     d = FlutterDerivatives(*(np.array([v]) for v in (1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0)))

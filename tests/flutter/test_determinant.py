@@ -2,7 +2,7 @@
 results and input that must be refused.
 
 Sources: the thesis, Eq 4.9, 4.26-4.29, 4.39-4.44, 5.15-5.21; Theodorsen (1935), NACA Report 496;
-Selberg (1961) as quoted in VALIDATION.md (about 5 %); Scanlan and Tomko (1971) for the derivative form.
+Selberg (1961), see docs/reference_cases.md (about 5 %); Scanlan and Tomko (1971) for the derivative form.
 """
 
 import csv

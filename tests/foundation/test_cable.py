@@ -62,7 +62,7 @@ def test_great_belt_against_thesis_numbers():
     s = load_scenario("great_belt")
     c = solve_cables(s)
     assert c.horizontal_force_total_N == pytest.approx(3.85e8, rel=0.01)  # Eq 1.1, 3.3
-    assert c.horizontal_force_per_cable_N == pytest.approx(1.94e8, rel=0.01)  # SPEC section 2
+    assert c.horizontal_force_per_cable_N == pytest.approx(1.94e8, rel=0.01)  # mu_b/2 per cable, thesis_errata.md
     assert c.horizontal_force_total_N > c.parabolic_estimate_total_N  # the arc is longer than the chord
     assert c.equilibrium_residual < 1e-6  # Eq 2.13
     assert c.main_residual < 1e-6

@@ -1,7 +1,8 @@
 """Up-scaling rules of thesis section 1.5 against the thesis's own tables.
 
 Sources: thesis Table 1.1 (A_c), Table 1.2 (h, L_s), Table 3.6 (mu, J) - numbers printed in the thesis,
-which this project did not write; SPEC.md section 1 gives the targets (0.5 % and 1 %).
+which this project did not write; targets 0.5 % and 1 % (three printed digits). The closed form of
+Eq 1.2 and its span limit: docs/thesis_errata.md, "Up-scaling".
 """
 
 import math
@@ -52,7 +53,7 @@ def test_eq_1_2_closed_form_satisfies_the_stress_equation():
 def test_span_limit_is_where_the_area_diverges():
     ref = load_scenario("great_belt")
     limit = span_limit_m(ref)
-    assert 5100 < limit < 5300  # SPEC: about 5.2 km for these data
+    assert 5100 < limit < 5300  # 5187 m for these data (docs/thesis_errata.md)
     assert cable_area_for_span(ref, 0.999 * limit) > 50 * ref.cable.area_m2
     with pytest.raises(InputError, match="geometry.main_span_m"):
         cable_area_for_span(ref, limit)

@@ -1,5 +1,5 @@
 """Frequencies of straight beams and strings against closed forms, with the observed convergence order
-(log-log slope over three refinements).  Sources: VALIDATION.md "Structures"; Blevins, Formulas for
+(log-log slope over three refinements).  Sources: docs/reference_cases.md "Structures"; Blevins, Formulas for
 Natural Frequency and Mode Shape (1979), tables 8-1 and 8-2; taut string f_n = (n / 2L) sqrt(T/m)."""
 
 from __future__ import annotations
@@ -37,7 +37,7 @@ def test_simply_supported_beam_fourth_order(plane, ei):
 
 @pytest.mark.parametrize("device", DEVICES)
 def test_cantilever_beta_L(device):
-    """beta_1 L = 1.8751, beta_2 L = 4.6941 (VALIDATION.md), f = (beta L)^2 / (2 pi L^2) sqrt(EI/m)."""
+    """beta_1 L = 1.8751, beta_2 L = 4.6941 (Blevins 1979), f = (beta L)^2 / (2 pi L^2) sqrt(EI/m)."""
     exact_beta = np.array([1.875104069, 4.694091133])
     errors = []
     for n in REFINEMENTS:
@@ -101,7 +101,7 @@ def test_beam_geometric_stiffness_under_tension():
 
 @pytest.mark.parametrize("lambda2", [10.0, 40.0, 150.0])
 def test_irvine_caughey_sagging_cable(lambda2):
-    """First symmetric in-plane mode of a shallow sagging cable (Irvine & Caughey 1974; VALIDATION.md):
+    """First symmetric in-plane mode of a shallow sagging cable (Irvine & Caughey 1974; docs/reference_cases.md):
     tan(w/2) = w/2 - (4/lambda^2)(w/2)^3, w = omega L sqrt(m/H), lambda^2 = (m g L/H)^2 L/(H L_e/EA).
     Checks the elastic (EA) and geometric (H) stiffness of the cable elements working together; the
     antisymmetric mode (w = 2 pi) does not stretch the cable and is independent of lambda^2."""
