@@ -82,6 +82,7 @@ def _added_mass_coefficient(n, nu=0.02, steps_per_period=400):
     return a_sin / (np.pi / 4 * amp * omega ** 2)
 
 
+@pytest.mark.slow  # ~10-25 s: runs in CI with -m slow
 def test_added_mass_of_an_oscillating_cylinder_converges():
     """Cylinder oscillating in fluid at rest with a resolved Stokes layer: beta = D^2 f/nu = 50,
     delta = sqrt(2 nu/w) = 0.08 D (1.3 / 2.5 cells at D/16 / D/32). Stokes (1851) and Wang (1968,
@@ -154,6 +155,7 @@ def test_rotating_cylinder_feels_only_a_resisting_torque():
     assert np.abs(f[-1, :2]).max() < 1e-6 * abs(mz)
 
 
+@pytest.mark.slow  # ~10-25 s: runs in CI with -m slow
 def test_dfg_pressure_difference_at_d16():
     """DFG benchmark 2D-1 (Schaefer and Turek 1996; docs/reference_cases.md): p(0.15, 0.2) - p(0.25, 0.2) =
     0.11752, c_D = 5.5795 on the cylinder in the channel, here at the coarse h = D/16 to t = 4 (the
@@ -220,6 +222,7 @@ def test_forced_faces_leave_no_cell_without_a_free_face_divergent(monkeypatch, c
         assert np.abs(div).max() > 1e-3 * scale, np.abs(div).max()
 
 
+@pytest.mark.slow  # ~15 s for the pair: runs in CI with -m slow
 @pytest.mark.parametrize("closed", [True, False])
 def test_heaving_body_force_without_step_to_step_noise(monkeypatch, closed):
     """A cylinder heaving (amplitude 0.1 D, period 2) in the stream at Re 20, D/16: the lift is smooth
