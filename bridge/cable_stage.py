@@ -133,15 +133,23 @@ def run(scenario: Scenario, upstream: dict, options: RunOptions) -> StageOutput:
         grp.attrs["first_vertical_frequency_eq_3_2_hz"] = c.first_vertical_frequency_estimate_hz
         for sp in c.spans:
             sg = grp.create_group(sp.name)
-            write_dataset(sg, "z", sp.z_m, "m", "position along the bridge, 0 at the left anchor")
-            write_dataset(sg, "elevation", sp.elevation_m, "m", "cable elevation above the pylon foundations")
-            write_dataset(sg, "slope", sp.slope, "1", "dy/dz of the cable")
+            n = len(sp.z_m)
+            write_dataset(sg, "z", sp.z_m, "m", f"({n},) position along the bridge at the RK4 nodes of the "
+                          f"{sp.name} span, 0 at the left anchor")
+            write_dataset(sg, "elevation", sp.elevation_m, "m", f"({n},) cable elevation above the pylon "
+                          "foundations at z")
+            write_dataset(sg, "slope", sp.slope, "1", f"({n},) cable slope dy/dz at z")
             sg.attrs["cable_length_m"] = sp.length_m
         hg = grp.create_group("hangers")
-        write_dataset(hg, "z", c.hanger_z_m, "m", "hanger position along the bridge")
-        write_dataset(hg, "cable_elevation", c.hanger_cable_elevation_m, "m", "cable elevation at the hanger")
-        write_dataset(hg, "length", c.hanger_length_m, "m", "hanger length, cable to girder axis")
-        write_dataset(hg, "span", c.hanger_span, "", "0 left side span, 1 main span, 2 right side span")
+        n = len(c.hanger_z_m)
+        write_dataset(hg, "z", c.hanger_z_m, "m", f"({n},) hanger positions along the bridge (one cable)")
+        write_dataset(hg, "cable_elevation", c.hanger_cable_elevation_m, "m",
+                      f"({n},) cable elevation at each hanger")
+        write_dataset(hg, "length", c.hanger_length_m, "m", f"({n},) hanger length from the cable to the "
+                      "girder axis")
+        write_dataset(hg, "span", c.hanger_span, "", f"({n},) span code of each hanger: 0 left side span, "
+                      "1 main span, 2 right side span")
+        hg["span"].attrs["unit"] = ""  # a code, no unit; write_dataset leaves an empty unit out
         rg = grp.create_group("reactions")
         rg.attrs["pylon_main_per_cable_N"] = c.v_pylon_main_per_cable_N
         rg.attrs["pylon_side_per_cable_N"] = c.v_pylon_side_per_cable_N

@@ -3,10 +3,11 @@
 Each stage's output is stored under a key, the SHA-256 of everything the result depends on:
 
 * the stage's name and the source text of its code (``Stage.code`` in :mod:`bridge.stages`: the
-  modules and packages that compute it) and the program version;
-* the scenario inputs (every field of the validated scenario, less ``IDENTITY_FIELDS`` and the
-  fields the stage declares it ``ignores``), and the bytes of every input file the scenario names
-  (``*_path`` keys, e.g. a measured aerodynamic table);
+  modules and packages that compute it, plus ``COMMON_CODE``, which writes every stage's output)
+  and the program version;
+* the scenario inputs (every field of the validated scenario, less ``IDENTITY_FIELDS``, the fields
+  the stage declares it ``ignores`` and, for a ``shared`` stage, the scenario's name), and the bytes
+  of every input file the scenario names (``*_path`` keys, e.g. a measured aerodynamic table);
 * the keys of the upstream stages it reads (a key fixes its output: same inputs, same code);
 * the run options that change results (``quick``).
 
@@ -39,6 +40,7 @@ from .stages import IDENTITY_FIELDS, STAGES, StageOutput
 __all__ = ["stage_key", "store", "load", "save", "StoredGroup", "CACHE_FORMAT"]
 
 CACHE_FORMAT = "1"  # bump when the entry layout changes
+COMMON_CODE = ("bridge.cache", "bridge.errors", "bridge.results", "bridge.stages")
 
 
 @cache
@@ -72,7 +74,7 @@ def stage_key(name: str, scenario: Any, upstream_keys: Mapping[str, str], quick:
     from .config import scenario_fields
 
     stage = STAGES[name]
-    skip = set(IDENTITY_FIELDS) | set(stage.ignores)
+    skip = set(IDENTITY_FIELDS) | set(stage.ignores) | ({"name"} if stage.shared else set())
     inputs = {k: v for k, v in scenario_fields(scenario).items() if k.split(".")[0].split("[")[0] not in skip}
     files = {}
     base = Path(scenario.source_path).parent if getattr(scenario, "source_path", None) else Path.cwd()
@@ -81,7 +83,7 @@ def stage_key(name: str, scenario: Any, upstream_keys: Mapping[str, str], quick:
             p = Path(v) if Path(v).is_absolute() else base / v
             files[k] = _file_digest(p) if p.is_file() else "missing"
     blob = json.dumps({"format": CACHE_FORMAT, "stage": name, "version": __version__,
-                       "code": _code_digest(stage.code), "inputs": inputs, "files": files,
+                       "code": _code_digest(COMMON_CODE + stage.code), "inputs": inputs, "files": files,
                        "upstream": {k: upstream_keys[k] for k in sorted(upstream_keys)}, "quick": bool(quick)},
                       sort_keys=True, default=repr)
     return hashlib.sha256(blob.encode()).hexdigest()
@@ -148,7 +150,7 @@ def load(root: Path, name: str, key: str) -> StageOutput | None:
     except Exception:  # a damaged or foreign entry is a miss, recomputed and replaced
         return None
     return StageOutput(summary=d["summary"], write_h5=StoredGroup(d["h5_image"]), report=d["report"],
-                       figures=d["figures"], data=d["data"])
+                       figures=d["figures"], data=d["data"], from_cache=True)
 
 
 def save(root: Path, name: str, key: str, output: StageOutput) -> None:

@@ -40,16 +40,15 @@ __all__ = ["write_results", "write_dataset", "check_target", "summary_json", "he
 SCHEMA_VERSION = "1"
 
 
-def write_dataset(group: h5py.Group, name: str, data: Any, unit: str = "", description: str = "") -> None:
-    """Write one dataset with its ``unit`` and ``description`` attributes (strings become UTF-8)."""
+def write_dataset(group: h5py.Group, name: str, data: Any, unit: str, description: str) -> None:
+    """Write one dataset with its ``unit`` ("1": dimensionless number, "": text or flag) and
+    ``description`` attributes (strings become UTF-8)."""
     arr = np.asarray(data)
     if arr.dtype.kind in "UO":
         arr = np.asarray(arr, dtype=h5py.string_dtype())
     ds = group.create_dataset(name, data=arr)
-    if unit:
-        ds.attrs["unit"] = unit
-    if description:
-        ds.attrs["description"] = description
+    ds.attrs["unit"] = unit  # always both attributes: "" for text and flags (docs/results.md)
+    ds.attrs["description"] = description
 
 
 def _json_value(v: Any) -> Any:

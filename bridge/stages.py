@@ -31,6 +31,7 @@ class StageOutput:
     figures  - ``{"file_name.png": matplotlib.figure.Figure}``, or PNG bytes once stored
                (:func:`bridge.cache.store`).
     data     - the stage's Python result object, for later stages.
+    from_cache - True when the output was taken from the stage cache instead of computed.
     """
 
     summary: dict[str, float | int | bool | str | None]
@@ -38,6 +39,7 @@ class StageOutput:
     report: str
     figures: dict[str, Any] = field(default_factory=dict)
     data: Any = None
+    from_cache: bool = False
 
 
 @dataclass(frozen=True)
@@ -65,12 +67,17 @@ class Stage:
               cache key (:mod:`bridge.cache`), so changed code never reuses an old result
     ignores - top-level scenario fields its result does not depend on (also left out of the cache key:
               changing the flutter options does not rerun the FEM)
+    shared  - the result does not depend on the scenario's name either, so scenarios and sweep cases
+              with the same inputs share one stored result (a deck section's aerodynamics).  The
+              cable, fem and flutter stages put the name in their titles and reference tables, so
+              they are not shared.
     """
 
     target: str
     needs: tuple[str, ...]
     code: tuple[str, ...]
     ignores: tuple[str, ...] = ()
+    shared: bool = False
 
 
 # The scenario fields that never change a result: how it is called and where it was read from.
@@ -82,7 +89,7 @@ STAGES: dict[str, Stage] = {
                    ignores=("damping", "air", "flutter", "section", "modal")),
     "fem": Stage("bridge.structure.stage:run", ("cable",), ("bridge.structure", "kernels.fem"),
                  ignores=("air", "flutter", "section", "modal")),
-    "flutter": Stage("bridge.flutter.stage:run", ("fem",), ("bridge.flutter",)),
+    "flutter": Stage("bridge.flutter.stage:run", ("fem",), ("bridge.flutter", "bridge.structure.plots")),
 }
 
 

@@ -128,8 +128,9 @@ def run_case(case: Case, out_dir: str, stages: list[str] | None, quick: bool,
             return case.name, "skipped"
         sc = load_scenario(case.scenario, main_span_m=case.main_span_m, overrides=dict(case.overrides))
         sc = replace(sc, name=case.name)
-        run_scenario(sc, Path(out_dir), stages, RunOptions(quick=quick, cache=Path(cache_dir) if cache_dir else None),
-                     overwrite=True, run_key=key)
+        _, outputs = run_scenario(sc, Path(out_dir), stages,
+                                  RunOptions(quick=quick, cache=Path(cache_dir) if cache_dir else None),
+                                  overwrite=True, run_key=key)
     except (InputError, ConvergenceError) as err:
         return case.name, f"error: {err}"
     except KeyboardInterrupt:
@@ -139,7 +140,8 @@ def run_case(case: Case, out_dir: str, stages: list[str] | None, quick: bool,
     finally:
         if in_worker:
             signal.signal(signal.SIGINT, signal.SIG_IGN)
-    return case.name, "done"
+    reused = [name for name, out in outputs.items() if out.from_cache]
+    return case.name, "done" + (f" (from the cache: {', '.join(reused)})" if reused else "")
 
 
 def _as_float(value: Any) -> float:

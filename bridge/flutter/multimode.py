@@ -57,6 +57,15 @@ class MultimodeResult:
     unresolved: tuple[tuple[str, float], ...] = ()  # (mode, V) where the p-k iteration found no root on the
                                                     # tracked branch (branch jumps); NaN there, listed in reports
 
+    @property
+    def oscillatory(self) -> np.ndarray:
+        """(n_V, N) bool: False where the tracked p-k eigenvalue is real (frequency 0, below 1e-6 of the
+        highest frequency of the sweep) or NaN.  On such a non-oscillatory branch zeta = -Re(s)/|s| is
+        exactly +1 (a decaying real root: aerodynamic damping above critical) or -1 (a growing real
+        root: static divergence), not a damping ratio of an oscillation."""
+        f = np.nan_to_num(self.frequency_hz, nan=0.0)
+        return f > 1e-6 * f.max(initial=0.0)
+
 
 def _state_matrix(model: ModalModel, aero: AerodynamicModel, rho: float, w: float, V: float) -> np.ndarray:
     B, L = model.deck_width_m, model.deck_length_m

@@ -7,7 +7,11 @@ Options from ``scenario.flutter`` (a :class:`FlutterOptions`; defaults if absent
 ``section.air_density_kg_m3``, else ``flutter.air_density_kg_m3``, else ``scenario.air.density_kg_m3``,
 else 1.225.  Every (bending, torsion) pair is solved by the determinant method; the governing pair is
 the one with the lowest critical speed; the p-k multimode sweep runs on all vertical and torsional
-modes.  HDF5 datasets are documented in docs/results_flutter.md.
+modes.  HDF5 datasets are documented in docs/results_flutter.md.  Summary values are strict JSON: None
+for a number that does not exist (no flutter, no divergence below the highest speed searched), True/False
+for flags.  Figures: the determinant map of the governing pair, the p-k damping plot, and, when the modes
+come from the fem stage, the mode shapes of the governing pair (and of the p-k mode that goes unstable)
+that the fem stage did not already draw.
 """
 
 from __future__ import annotations
@@ -82,58 +86,83 @@ def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
     mm = pk_sweep(modal, aero, rho, fopts.max_speed_m_s, **kw) if fopts.multimode else None
     data = FlutterStageResult(modal, aero.name, rho, pairs, gov, mm)
     return StageOutput(summary=_summary(data, fopts), write_h5=lambda g: _write_h5(g, data),
-                       report=_report(data, source, fopts), figures=_figures(data), data=data)
+                       report=_report(data, source, fopts),
+                       figures={**_mode_shape_figures(data, upstream), **_figures(data)}, data=data)
 
 
 def _pair_name(r: FlutterResult) -> str:
     return f"{r.pair[0]}+{r.pair[1]}"
 
 
-def _summary(d: FlutterStageResult, fopts: FlutterOptions) -> dict[str, float | int | str]:
+def _number(x: float) -> float | None:
+    """A summary number, or None where it does not exist (NaN/inf): summary.json stays strict JSON."""
+    return float(x) if math.isfinite(x) else None
+
+
+def _summary(d: FlutterStageResult, fopts: FlutterOptions) -> dict[str, float | int | bool | str | None]:
+    """Headline numbers; None where there is no solution below the highest speed searched."""
     g = d.governing
-    s: dict[str, float | int | str] = {"flutter.flutter": int(g is not None),
-                                       "flutter.max_speed_searched_m_s": float(fopts.max_speed_m_s)}
-    if g is not None:
-        s.update({"flutter.critical_speed_m_s": g.critical_speed_m_s, "flutter.frequency_hz": g.frequency_hz,
-                  "flutter.reduced_frequency": g.reduced_frequency, "flutter.mode_pair": _pair_name(g)})
-    else:
-        s.update({k: "none" for k in ("flutter.critical_speed_m_s", "flutter.frequency_hz",
-                                      "flutter.reduced_frequency", "flutter.mode_pair")})
+    s: dict[str, float | int | bool | str | None] = {
+        "flutter.flutter": g is not None, "flutter.max_speed_searched_m_s": float(fopts.max_speed_m_s),
+        "flutter.critical_speed_m_s": None if g is None else _number(g.critical_speed_m_s),
+        "flutter.frequency_hz": None if g is None else _number(g.frequency_hz),
+        "flutter.reduced_frequency": None if g is None else _number(g.reduced_frequency),
+        "flutter.mode_pair": None if g is None else _pair_name(g)}
     for r in d.pairs:
         key = f"flutter.pair_{r.pair[0]}+{r.pair[1]}"
-        s[f"{key}.critical_speed_m_s"] = r.critical_speed_m_s if r.flutter else "none"
-        s[f"{key}.frequency_hz"] = r.frequency_hz if r.flutter else "none"
+        s[f"{key}.critical_speed_m_s"] = _number(r.critical_speed_m_s) if r.flutter else None
+        s[f"{key}.frequency_hz"] = _number(r.frequency_hz) if r.flutter else None
     if d.multimode is not None:
         m = d.multimode
-        s["flutter.multimode_critical_speed_m_s"] = m.critical_speed_m_s if m.flutter else "none"
-        s["flutter.divergence_speed_m_s"] = "none" if math.isnan(m.divergence_speed_m_s) else m.divergence_speed_m_s
+        s["flutter.multimode_critical_speed_m_s"] = _number(m.critical_speed_m_s) if m.flutter else None
+        s["flutter.divergence_speed_m_s"] = _number(m.divergence_speed_m_s)
     return s
 
 
-def _write_h5(group: Any, d: FlutterStageResult) -> None:
-    """Fill ``results.h5:/flutter`` (``group`` is an h5py Group); see docs/results_flutter.md."""
-    import h5py
+def _text(group: Any, name: str, values: Any, description: str) -> None:
+    write_dataset(group, name, [str(v) for v in values], "", description)
 
-    text = h5py.string_dtype()
+
+def _write_h5(group: Any, d: FlutterStageResult) -> None:
+    """Fill ``results.h5:/flutter`` (``group`` is an h5py Group); see docs/results_flutter.md.  Every dataset
+    has a ``unit`` ("1" dimensionless, "" text or flag) and a ``description`` (shape, meaning)."""
     group.attrs["aerodynamics"] = d.aerodynamics
     group.attrs["air_density_kg_m3"] = d.air_density_kg_m3
     m = d.modal_model
+    n = m.n_modes
     g = group.create_group("modal")
-    g.create_dataset("labels", data=np.array(m.labels, dtype=object), dtype=text)
-    g.create_dataset("kinds", data=np.array(m.kinds, dtype=object), dtype=text)
-    g.create_dataset("symmetries", data=np.array(m.symmetries, dtype=object), dtype=text)
-    for name in ("frequencies_hz", "damping_ratios", "uu", "ut", "tt", "modal_masses"):
-        g.create_dataset(name, data=np.asarray(getattr(m, name), dtype=np.float64))
+    _text(g, "labels", m.labels, f"({n},) labels of the modes used, e.g. S-V1 (symmetry-kind letter count)")
+    _text(g, "kinds", m.kinds, f"({n},) vertical / torsional / lateral")
+    _text(g, "symmetries", m.symmetries, f"({n},) S (symmetric) or SS (skew-symmetric) about mid-span")
+    write_dataset(g, "frequencies_hz", np.asarray(m.frequencies_hz, dtype=np.float64), "Hz",
+                  f"({n},) undamped natural frequencies f_i")
+    write_dataset(g, "damping_ratios", np.asarray(m.damping_ratios, dtype=np.float64), "1",
+                  f"({n},) structural damping ratios zeta_i")
+    for name, what in (("uu", "U_i U_j"), ("ut", "U_i Theta_j"), ("tt", "Theta_i Theta_j")):
+        write_dataset(g, name, np.asarray(getattr(m, name), dtype=np.float64), "1",
+                      f"({n}, {n}) (1/L) int {what} dz over the deck length L (Eq 4.34)")
+    write_dataset(g, "modal_masses", np.asarray(m.modal_masses, dtype=np.float64), "kg or kg m^2",
+                  f"({n},) m_i = L (mu uu_ii + J tt_ii) (Eq 4.33): kg for vertical and lateral modes, "
+                  "kg m^2 for torsional modes")
     for name in ("mass_per_length_kg_m", "inertia_per_length_kg_m2_m", "deck_width_m", "deck_length_m"):
         g.attrs[name] = getattr(m, name)
     p = group.create_group("pairs")
-    p.create_dataset("bending", data=np.array([r.pair[0] for r in d.pairs], dtype=object), dtype=text)
-    p.create_dataset("torsion", data=np.array([r.pair[1] for r in d.pairs], dtype=object), dtype=text)
-    p.create_dataset("flutter", data=np.array([r.flutter for r in d.pairs], dtype=np.int8))
-    for name in ("critical_speed_m_s", "frequency_hz", "reduced_frequency", "residual",
-                 "min_speed_searched_m_s", "max_speed_searched_m_s"):
-        p.create_dataset(name, data=np.array([getattr(r, name) for r in d.pairs], dtype=np.float64))
-    p.create_dataset("iterations", data=np.array([r.iterations for r in d.pairs], dtype=np.int64))
+    n_p = len(d.pairs)
+    _text(p, "bending", [r.pair[0] for r in d.pairs], f"({n_p},) bending (vertical) mode of each pair")
+    _text(p, "torsion", [r.pair[1] for r in d.pairs], f"({n_p},) torsional mode of each pair")
+    write_dataset(p, "flutter", np.array([r.flutter for r in d.pairs], dtype=np.int8), "",
+                  f"({n_p},) flag: 1 if the pair flutters below its maximum speed searched, else 0")
+    for name, unit, what in (
+            ("critical_speed_m_s", "m/s", "critical wind speed V_c (NaN if none)"),
+            ("frequency_hz", "Hz", "flutter frequency f_c (NaN if none)"),
+            ("reduced_frequency", "1", "reduced flutter frequency Omega_c = w_c B / V_c, Eq 4.38 (NaN if none)"),
+            ("residual", "1", "|det D| / (|D11 D22| + |D12 D21|) at the solution (Eq 5.16)"),
+            ("min_speed_searched_m_s", "m/s", "lowest wind speed of the bracketing scan"),
+            ("max_speed_searched_m_s", "m/s", "highest wind speed of the bracketing scan")):
+        write_dataset(p, name, np.array([getattr(r, name) for r in d.pairs], dtype=np.float64), unit,
+                      f"({n_p},) {what}")
+    write_dataset(p, "iterations", np.array([r.iterations for r in d.pairs], dtype=np.int64), "1",
+                  f"({n_p},) Newton-Raphson iterations (Eq 5.19-5.21; 0 if no flutter)")
     gv = group.create_group("governing")
     gv.attrs["flutter"] = int(d.governing is not None)
     if d.governing is not None:
@@ -143,19 +172,31 @@ def _write_h5(group: Any, d: FlutterStageResult) -> None:
             gv.attrs[name] = getattr(r, name)
     shown = d.governing or d.pairs[0]
     if shown.scan is not None:
-        s = group.create_group("determinant_map")
-        s.attrs["mode_pair"] = _pair_name(shown)
-        s.create_dataset("reduced_frequency", data=shown.scan.reduced_frequency)
-        s.create_dataset("speed_m_s", data=shown.scan.speed_m_s)
-        s.create_dataset("f1", data=shown.scan.f1)
-        s.create_dataset("f2", data=shown.scan.f2)
+        sc = shown.scan
+        g = group.create_group("determinant_map")
+        g.attrs["mode_pair"] = _pair_name(shown)
+        shape = "x".join(str(k) for k in sc.f1.shape)
+        write_dataset(g, "reduced_frequency", sc.reduced_frequency, "1",
+                      f"({shape}) [Omega row, V column] Omega = w B / V at each scan point (w on a fixed grid)")
+        write_dataset(g, "speed_m_s", sc.speed_m_s, "m/s", f"({sc.speed_m_s.size},) wind speeds of the columns")
+        for name, part in (("f1", "real"), ("f2", "imaginary")):
+            write_dataset(g, name, getattr(sc, name), "1",
+                          f"({shape}) {part} part of det D(Omega, V), the reduced determinant of pair "
+                          f"{_pair_name(shown)} (Eq 5.15-5.16); NaN outside a table's range")
     if d.multimode is not None:
         mm = d.multimode
+        nv, nm = mm.damping_ratio.shape
         g = group.create_group("multimode")
-        g.create_dataset("labels", data=np.array(mm.labels, dtype=object), dtype=text)
-        g.create_dataset("speed_m_s", data=mm.speed_m_s)
-        g.create_dataset("frequency_hz", data=mm.frequency_hz)
-        g.create_dataset("damping_ratio", data=mm.damping_ratio)
+        _text(g, "labels", mm.labels, f"({nm},) vertical and torsional modes of the p-k sweep (columns below)")
+        write_dataset(g, "speed_m_s", mm.speed_m_s, "m/s", f"({nv},) wind speeds of the sweep (rows below)")
+        write_dataset(g, "frequency_hz", mm.frequency_hz, "Hz",
+                      f"({nv}, {nm}) [speed, mode] p-k frequency Im(s) / 2 pi; 0 on a non-oscillatory "
+                      "branch (real eigenvalue); NaN where the mode left the aerodynamic model's range or "
+                      "found no root")
+        write_dataset(g, "damping_ratio", mm.damping_ratio, "1",
+                      f"({nv}, {nm}) [speed, mode] total (structural + aerodynamic) damping ratio "
+                      "-Re(s) / |s|; exactly +1 (decaying) or -1 (growing: static divergence) on a "
+                      "non-oscillatory branch (real eigenvalue, frequency 0); NaN as for frequency_hz")
         g.attrs["flutter"] = int(mm.flutter)
         g.attrs["critical_speed_m_s"] = mm.critical_speed_m_s
         g.attrs["frequency_hz"] = mm.frequency_hz_at_flutter
@@ -164,9 +205,10 @@ def _write_h5(group: Any, d: FlutterStageResult) -> None:
         g.attrs["divergence_speed_m_s"] = mm.divergence_speed_m_s
         g.attrs["unresolved_points"] = len(mm.unresolved)
         if mm.unresolved:
-            write_dataset(g, "unresolved_mode", [u[0] for u in mm.unresolved], "",
-                          "modes whose p-k iteration found no root on the tracked branch (NaN in the sweep)")
-            write_dataset(g, "unresolved_speed_m_s", [u[1] for u in mm.unresolved], "m/s", "speeds of those points")
+            _text(g, "unresolved_mode", [u[0] for u in mm.unresolved],
+                  "modes whose p-k iteration found no root on the tracked branch (NaN in the sweep)")
+            write_dataset(g, "unresolved_speed_m_s", [u[1] for u in mm.unresolved], "m/s",
+                          "wind speeds of those points, one per unresolved_mode entry")
 
 
 def _report(d: FlutterStageResult, source: str, fopts: FlutterOptions) -> str:
@@ -197,6 +239,13 @@ def _report(d: FlutterStageResult, source: str, fopts: FlutterOptions) -> str:
             else f"no damping ratio of an oscillating mode crosses zero below {m.max_speed_searched_m_s:g} m/s.")]
         if not math.isnan(m.divergence_speed_m_s):
             lines.append(f"Static divergence (frequency to zero) at V = {m.divergence_speed_m_s:.2f} m/s.")
+        real = [lab for i, lab in enumerate(m.labels) if not m.oscillatory[:, i].all()]
+        if real:
+            lines.append(f"Non-oscillatory branches ({', '.join(real)}): above some speed the tracked p-k "
+                         "eigenvalue is real (frequency 0), so -Re(s)/|s| is exactly +1 (decaying: aerodynamic "
+                         "damping above critical) or -1 (growing: static divergence); these points are no "
+                         "damping ratio of an oscillation and are drawn as crosses at f = 0 in "
+                         "flutter_damping.png, not as damping ratios.")
         if m.unresolved:
             pts = ", ".join(f"{lab} at {v:.1f} m/s" for lab, v in m.unresolved[:8])
             lines.append(f"p-k found no frequency root on the tracked branch at {len(m.unresolved)} point(s) "
@@ -205,8 +254,77 @@ def _report(d: FlutterStageResult, source: str, fopts: FlutterOptions) -> str:
     return "\n".join(lines) + "\n"
 
 
+def _mode_shape_figures(d: FlutterStageResult, upstream: dict) -> dict[str, Any]:
+    """Mode shapes of the governing pair and of the p-k mode that goes unstable, when the modes come from
+    the fem stage (its result has the shapes; a [modal] table or a section has none); a figure the fem
+    stage already made under the same file name is not drawn again."""
+    fem = upstream.get("fem")
+    result = getattr(fem, "data", None)
+    if not hasattr(result, "modes"):          # modes from a table or a section model: no shapes to draw
+        return {}
+    from bridge.structure.plots import mode_shape_figure, mode_shape_file_name
+
+    roles: dict[str, str] = {}
+    if d.governing is not None:
+        for label in d.governing.pair:
+            roles[label] = f"governing flutter pair {_pair_name(d.governing)}"
+    if d.multimode is not None and d.multimode.flutter:
+        roles.setdefault(d.multimode.unstable_mode, "goes unstable in the multimode p-k sweep")
+    return {mode_shape_file_name(label): mode_shape_figure(result, label, note)
+            for label, note in roles.items() if mode_shape_file_name(label) not in fem.figures}
+
+
+def _damping_figure(m: MultimodeResult) -> Any:
+    """p-k damping ratio and frequency against V: the branch that goes unstable (or, without flutter, the
+    least damped one) in colour, the others thin grey (S solid, SS dashed).  Non-oscillatory points (real
+    eigenvalue, ``MultimodeResult.oscillatory`` False: zeta exactly +-1) are left out of the damping panel
+    and marked by crosses at f = 0 in the frequency panel."""
+    from matplotlib.figure import Figure  # Agg canvas, no pyplot state
+
+    osc = m.oscillatory
+    zeta = np.where(osc, m.damping_ratio, np.nan)
+    if m.flutter:
+        key = m.labels.index(m.unstable_mode)
+        key_text = f"{m.unstable_mode}: goes unstable"
+    else:
+        key = int(np.argmin(np.nanmin(np.where(np.isnan(zeta), np.inf, zeta), axis=0)))
+        key_text = f"{m.labels[key]}: least damped (no flutter)"
+    fig = Figure(figsize=(8.0, 6.4), layout="constrained")
+    ax1, ax2 = fig.subplots(2, 1, sharex=True)
+    for i, label in enumerate(m.labels):
+        if i == key:
+            continue
+        style = dict(color="0.65", lw=0.8, ls="--" if label.startswith("SS-") else "-")
+        ax1.plot(m.speed_m_s, zeta[:, i], **style)
+        ax2.plot(m.speed_m_s, np.where(osc[:, i], m.frequency_hz[:, i], np.nan), **style)
+    ax1.plot(m.speed_m_s, zeta[:, key], color="C3", lw=2.2, label=key_text)
+    ax2.plot(m.speed_m_s, np.where(osc[:, key], m.frequency_hz[:, key], np.nan), color="C3", lw=2.2)
+    ax1.plot([], [], color="0.65", lw=0.8, label="other modes (S solid, SS dashed)")
+    real = ~osc & np.isfinite(m.frequency_hz)
+    if real.any():
+        rows = np.nonzero(real)[0]
+        ax2.plot(m.speed_m_s[rows], np.zeros(rows.size), "x", color="0.35", ms=4,
+                 label="non-oscillatory (real eigenvalue, f = 0: zeta = +-1, not drawn above)")
+    ax1.axhline(0.0, color="k", lw=0.5)
+    for ax, labelled in ((ax1, True), (ax2, False)):
+        if m.flutter:
+            ax.axvline(m.critical_speed_m_s, color="k", ls=":",
+                       label=f"flutter V_c = {m.critical_speed_m_s:.1f} m/s" if labelled else None)
+        if np.isfinite(m.divergence_speed_m_s):
+            ax.axvline(m.divergence_speed_m_s, color="C1", ls="-.",
+                       label=f"static divergence V_D = {m.divergence_speed_m_s:.1f} m/s" if labelled else None)
+        ax.grid(alpha=0.3)
+    ax1.set_ylabel("total damping ratio zeta [-]")
+    ax2.set_ylabel("frequency [Hz]")
+    ax2.set_xlabel("V [m/s]")
+    ax1.legend(fontsize="small", loc="upper left")
+    if real.any():
+        ax2.legend(fontsize="small", loc="upper center", bbox_to_anchor=(0.5, -0.18))
+    ax1.set_title(f"Multimode p-k, {len(m.labels)} modes: damping ratio -Re(s)/|s| and frequency against V")
+    return fig
+
+
 def _figures(d: FlutterStageResult) -> dict[str, Any]:
-    import matplotlib
     from matplotlib.figure import Figure  # Agg canvas, no pyplot state
 
     figs: dict[str, Any] = {}
@@ -227,27 +345,10 @@ def _figures(d: FlutterStageResult) -> dict[str, Any]:
             ax.plot(shown.critical_speed_m_s, shown.reduced_frequency, "ko", label="(V_c, Omega_c)")
         ax.set_yscale("log")
         ax.set_xlabel("V [m/s]")
-        ax.set_ylabel("Omega = w B / V")
+        ax.set_ylabel("reduced frequency Omega = w B / V [-]")
         ax.set_title(f"Determinant components, pair {_pair_name(shown)} (Eq 5.16)")
         ax.legend()
         figs["flutter_determinant.png"] = fig
     if d.multimode is not None:
-        m = d.multimode
-        fig = Figure(figsize=(8.0, 6.4), layout="constrained")
-        ax1, ax2 = fig.add_subplot(2, 1, 1), fig.add_subplot(2, 1, 2)
-        colours = matplotlib.colormaps["tab20"]
-        for i, label in enumerate(m.labels):
-            style = dict(color=colours(i % 20), ls="--" if label.startswith("SS-") else "-", label=label)
-            ax1.plot(m.speed_m_s, m.damping_ratio[:, i], **style)
-            ax2.plot(m.speed_m_s, m.frequency_hz[:, i], **style)
-        ax1.axhline(0.0, color="k", lw=0.5)
-        if m.flutter:
-            ax1.axvline(m.critical_speed_m_s, color="k", ls=":", label=f"V_c = {m.critical_speed_m_s:.1f} m/s")
-        ax1.set_ylabel("damping ratio")
-        ax2.set_ylabel("frequency [Hz]")
-        ax2.set_xlabel("V [m/s]")
-        ax1.legend(fontsize="small", loc="center left", bbox_to_anchor=(1.01, 0.0),
-                   ncol=1 + len(m.labels) // 13)
-        ax1.set_title("Multimode p-k: damping and frequency against wind speed")
-        figs["flutter_damping.png"] = fig
+        figs["flutter_damping.png"] = _damping_figure(d.multimode)
     return figs

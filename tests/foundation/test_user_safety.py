@@ -170,7 +170,7 @@ def test_sweep_resumes_only_cases_run_with_the_same_stages(tmp_path):
     assert cli(*base, "--stages", "cable", module="bridge.sweep").returncode == 0
     proc = cli(*base, module="bridge.sweep")
     assert proc.returncode == 0, proc.stderr
-    assert "skipped" not in proc.stderr and ": done" in proc.stderr
+    assert "skipped" not in proc.stderr and ": done (from the cache: cable)" in proc.stderr
     (case,) = (tmp_path / "sweep_great_belt" / "cases").iterdir()
     assert "flutter.critical_speed_m_s" in strict_json(case / "summary.json")
     assert "skipped" in cli(*base, module="bridge.sweep").stderr  # the same inputs and stages again
