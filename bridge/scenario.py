@@ -9,8 +9,10 @@ Finished stages are kept in ``OUT/.cache/`` and reused while their inputs are un
 from __future__ import annotations
 
 import argparse
+import os
 import signal
 import sys
+import threading
 import time
 import tomllib
 from collections.abc import Sequence
@@ -137,21 +139,34 @@ class Interrupts:
     def __init__(self):
         self.fired = False
         self._previous = None
+        self._hook = None
 
     def _handler(self, signum, frame):
         self.fired = True
         raise KeyboardInterrupt
+
+    def _unraisable(self, info) -> None:
+        """An interrupt that landed in a destructor or weakref callback is swallowed there (Python
+        prints "Exception ignored in ..." and goes on): deliver it again, to the main flow."""
+        if isinstance(info.exc_value, KeyboardInterrupt):
+            # from another thread, so that it arrives after this hook has returned, not inside it
+            threading.Timer(0.001, os.kill, (os.getpid(), signal.SIGINT)).start()
+        else:
+            self._hook(info)
 
     def __enter__(self):
         try:
             self._previous = signal.signal(signal.SIGINT, self._handler)
         except ValueError:  # not the main thread (e.g. called from a worker): leave SIGINT alone
             self._previous = None
+            return self
+        self._hook, sys.unraisablehook = sys.unraisablehook, self._unraisable
         return self
 
     def __exit__(self, *exc):
         if self._previous is not None:
             signal.signal(signal.SIGINT, self._previous)
+            sys.unraisablehook = self._hook
         return False
 
 
