@@ -181,8 +181,14 @@ class ModalModel:
                        labels: tuple[str, str] = ("S-V1", "S-T1")) -> ModalModel:
         """A bending mode j (Theta_j = 0) and a torsional mode k (U_k = 0), Eq 4.30, given a_jj, a_kk,
         a_jk of Eq 4.34 directly (e.g. the thesis's Table 3.6)."""
-        for key, v in (("a_jj", a_jj), ("a_kk", a_kk)):
+        for key, v in (("a_jj", a_jj), ("a_kk", a_kk), ("bending_frequency_hz", bending_frequency_hz),
+                       ("torsion_frequency_hz", torsion_frequency_hz), ("mass_per_length_kg_m", mass_per_length_kg_m),
+                       ("inertia_per_length_kg_m2_m", inertia_per_length_kg_m2_m), ("deck_width_m", deck_width_m),
+                       ("deck_length_m", deck_length_m)):  # named as the user typed them, before the arrays
             check_range(f"modal.{key}", v, low=0.0, low_open=True)
+        for key, v in (("bending_damping_ratio", bending_damping_ratio),
+                       ("torsion_damping_ratio", torsion_damping_ratio)):
+            check_range(f"modal.{key}", v, low=0.0, high=1.0, high_open=True)
         check_range("modal.a_jk", a_jk)
         ut = np.zeros((2, 2))
         ut[0, 1] = a_jk

@@ -103,7 +103,8 @@ def _summary(d: FlutterStageResult, fopts: FlutterOptions) -> dict[str, float | 
     """Headline numbers; None where there is no solution below the highest speed searched."""
     g = d.governing
     s: dict[str, float | int | bool | str | None] = {
-        "flutter.flutter": g is not None, "flutter.max_speed_searched_m_s": float(fopts.max_speed_m_s),
+        "flutter.flutter": g is not None, "flutter.aerodynamics": d.aerodynamics,
+        "flutter.max_speed_searched_m_s": float(fopts.max_speed_m_s),
         "flutter.critical_speed_m_s": None if g is None else _number(g.critical_speed_m_s),
         "flutter.frequency_hz": None if g is None else _number(g.frequency_hz),
         "flutter.reduced_frequency": None if g is None else _number(g.reduced_frequency),

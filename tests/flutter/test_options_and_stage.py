@@ -56,7 +56,7 @@ def test_section_and_modal_tables_name_the_bad_key():
     np.testing.assert_allclose(m.modal_masses, [23_000.0 * 2694.0 * 0.308, 2.5e6 * 2694.0 * 0.239])
     with pytest.raises(InputError) as err:
         ModalModel.from_mapping({**modal, "torsion_damping_ratio": -0.1}, "bridge.modal")
-    assert err.value.key == "bridge.modal.damping_ratios[1]"
+    assert err.value.key == "bridge.modal.torsion_damping_ratio"   # the key the user typed
 
 
 def _scenario(**kw):

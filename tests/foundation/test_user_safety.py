@@ -145,6 +145,78 @@ def test_infinite_numbers_are_refused(tmp_path, key, line_pattern):
     assert not (tmp_path / "out").exists()
 
 
+def _numeric_leaves(node, prefix=""):
+    """Dotted paths of every number in a TOML tree (lists of tables included)."""
+    if isinstance(node, dict):
+        for k, v in node.items():
+            yield from _numeric_leaves(v, f"{prefix}.{k}" if prefix else k)
+    elif isinstance(node, list):
+        for i, v in enumerate(node):
+            yield from _numeric_leaves(v, f"{prefix}[{i}]")
+    elif isinstance(node, (int, float)) and not isinstance(node, bool):
+        yield prefix
+
+
+def _set(node, path, value):
+    parts = re.findall(r"[^.\[\]]+|\[\d+\]", path)
+    for part in parts[:-1]:
+        node = node[int(part[1:-1])] if part.startswith("[") else node[part]
+    last = parts[-1]
+    if last.startswith("["):
+        node[int(last[1:-1])] = value
+    else:
+        node[last] = value
+
+
+@pytest.mark.parametrize("scenario", sorted(f.stem for f in SCENARIO_DIR.glob("*.toml")))
+def test_every_number_of_every_shipped_scenario_refuses_inf_and_nan(tmp_path, scenario):
+    """Every numeric key, set to inf, -inf or NaN, is an InputError naming that key (read in-process:
+    the three command-line cases above show that an InputError is one line and exit 2)."""
+    import copy
+    import tomllib
+
+    from bridge.config import load_scenario
+    from bridge.errors import InputError
+
+    data = tomllib.loads((SCENARIO_DIR / f"{scenario}.toml").read_text())
+    paths = list(_numeric_leaves(data))
+    assert paths or "reference" in data
+    for path in paths:
+        for bad in (float("inf"), -float("inf"), float("nan")):
+            d = copy.deepcopy(data)
+            _set(d, path, bad)
+            f = tmp_path / f"{scenario}.toml"
+            f.write_text(_toml(d))
+            with pytest.raises(InputError) as err:
+                load_scenario(f)
+            assert err.value.key.split(".")[-1].split("[")[0] in path, (path, str(err.value))
+
+
+def _toml(data, prefix=""):
+    """A minimal TOML writer for the shipped scenarios' shapes (tables, inline tables, lists of tables)."""
+    def value(v):
+        if isinstance(v, bool):
+            return "true" if v else "false"
+        if isinstance(v, float):
+            return "nan" if v != v else ("inf" if v == float("inf") else "-inf" if v == -float("inf") else repr(v))
+        if isinstance(v, int):
+            return str(v)
+        if isinstance(v, str):
+            return json.dumps(v)
+        if isinstance(v, dict):
+            return "{ " + ", ".join(f"{k} = {value(x)}" for k, x in v.items()) + " }"
+        if isinstance(v, list):
+            return "[ " + ", ".join(value(x) for x in v) + " ]"
+        raise TypeError(v)
+
+    lines = [f"{k} = {value(v)}" for k, v in data.items() if not isinstance(v, dict)]
+    for k, v in data.items():
+        if isinstance(v, dict):
+            name = f"{prefix}.{k}" if prefix else k
+            lines += ["", f"[{name}]", _toml(v, name)]
+    return "\n".join(lines)
+
+
 @pytest.mark.parametrize("stages", ["", ",,,", " , "])
 def test_an_empty_stage_list_is_an_error(tmp_path, stages):
     line = one_error_line(cli("great_belt", "--stages", stages, "--out", str(tmp_path / "out")))
@@ -280,6 +352,7 @@ def test_headline_on_the_terminal_and_atop_the_report(tmp_path):
         block = proc.stdout.split(f"{name}: results in")[1]
         assert re.search(r"flutter speed V_c = \d+\.\d m/s at f = 0\.\d+ Hz", block)
         assert "governing modes S" in block and "multimode p-k V_c" in block and "divergence" in block
+        assert "theodorsen aerodynamics" in block
         report = (tmp_path / name / "report.md").read_text().splitlines()
         assert report[2].startswith("**Flutter speed V_c = "), report[:4]
     table = (tmp_path / "comparison.md").read_text()
