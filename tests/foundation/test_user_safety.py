@@ -344,6 +344,24 @@ def test_stage_key_follows_code_inputs_upstream_and_input_files(tmp_path):
     assert stage_key("flutter", with_file, {}, False) != k1
 
 
+def test_a_shared_stage_is_one_result_for_scenarios_of_other_names(monkeypatch):
+    """A stage declared ``shared`` (a deck's aerodynamics) leaves the name out of its key, so two bridges
+    with the same inputs share it; the name-bearing stages of today do not."""
+    from dataclasses import replace
+
+    from bridge import stages
+    from bridge.cache import stage_key
+    from bridge.config import load_scenario
+
+    a = load_scenario("great_belt")
+    b = replace(a, name="another_bridge", description="a copy", source_path="/elsewhere/x.toml")
+    assert stage_key("cable", a, {}, False) != stage_key("cable", b, {}, False)
+    monkeypatch.setitem(stages.STAGES, "cable", replace(stages.STAGES["cable"], shared=True))
+    assert stage_key("cable", a, {}, False) == stage_key("cable", b, {}, False)
+    c = replace(b, girder=replace(b.girder, width_m=30.0))
+    assert stage_key("cable", a, {}, False) != stage_key("cable", c, {}, False)
+
+
 # ------------------------------------------------------------------------------ what a user reads
 def test_headline_on_the_terminal_and_atop_the_report(tmp_path):
     proc = cli("great_belt", "model_c", "--quick", "--out", str(tmp_path))
