@@ -7,7 +7,7 @@ Options from ``scenario.flutter`` (a :class:`FlutterOptions`; defaults if absent
 ``section.air_density_kg_m3``, else ``flutter.air_density_kg_m3``, else ``scenario.air.density_kg_m3``,
 else 1.225.  Every (bending, torsion) pair is solved by the determinant method; the governing pair is
 the one with the lowest critical speed; the p-k multimode sweep runs on all vertical and torsional
-modes.  HDF5 datasets are documented in docs/results_flutter.md.  Summary values are strict JSON: None
+modes.  HDF5 datasets: docs/results.md, section ``/flutter``.  Summary values are strict JSON: None
 for a number that does not exist (no flutter, no divergence below the highest speed searched), True/False
 for flags.  Figures: the determinant map of the governing pair, the p-k damping plot, and, when the modes
 come from the fem stage, the mode shapes of the governing pair (and of the p-k mode that goes unstable)
@@ -125,8 +125,8 @@ def _text(group: Any, name: str, values: Any, description: str) -> None:
 
 
 def _write_h5(group: Any, d: FlutterStageResult) -> None:
-    """Fill ``results.h5:/flutter`` (``group`` is an h5py Group); see docs/results_flutter.md.  Every dataset
-    has a ``unit`` ("1" dimensionless, "" text or flag) and a ``description`` (shape, meaning)."""
+    """Fill ``results.h5:/flutter`` (``group`` is an h5py Group); see docs/results.md, section ``/flutter``.
+    Every dataset has a ``unit`` ("1" dimensionless, "" text or flag) and a ``description`` (shape, meaning)."""
     group.attrs["aerodynamics"] = d.aerodynamics
     group.attrs["air_density_kg_m3"] = d.air_density_kg_m3
     m = d.modal_model

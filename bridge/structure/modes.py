@@ -22,11 +22,10 @@ uu[i, j] = (1/L) int U_i U_j, ut[i, j] = (1/L) int U_i Theta_j, tt[i, j] = (1/L)
 the trapezoidal rule on the girder nodes (n_sub nodes per hanger panel; the refinement study shows the
 effect).
 
-Damping (thesis 1.5, 3.3: the Table 3.4 ratios are used for every bridge): vertical and torsional modes
-take the ratios of Table 3.4 by symmetry rank - the n-th S mode (vertical or torsional, ascending
-frequency) gets the n-th "S" row, the n-th SS mode the n-th "SS" row; beyond the table, the last row of
-that symmetry.  Lateral, longitudinal and cable modes (Table 3.4 lists none; the operational modal
-analysis measured deck vertical/torsional response) get the last row of their symmetry.
+Damping (thesis 1.5, 3.3: the Table 3.4 ratios are used for every bridge; :func:`assign_damping`): every
+mode, whatever its kind, takes the ratio of the Table 3.4 row (``scenario.damping``) of the same symmetry
+whose frequency is nearest to the mode's own (on a tie the earlier row); if the table has no row of that
+symmetry, the nearest row of any symmetry; with an empty table, 0.
 """
 
 from __future__ import annotations

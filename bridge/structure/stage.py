@@ -3,7 +3,7 @@
 ``run(scenario, upstream, options)`` needs ``upstream["cable"].data`` (the CableSolution).
 ``options.quick``: 2 elements per hanger panel and 30 modes (tests, smoke runs); otherwise
 DEFAULT_ELEMENTS_PER_PANEL and DEFAULT_N_MODES of :mod:`.analysis`.
-HDF5 datasets of the ``fem`` group: docs/results_fem.md.
+HDF5 datasets of the ``fem`` group: docs/results.md, section ``/fem``.
 """
 
 from __future__ import annotations
