@@ -8,10 +8,17 @@ Finished stages are kept in ``OUT/.cache/`` and reused while their inputs are un
 
 from __future__ import annotations
 
-import argparse
 import os
 import signal
 import sys
+
+if __name__ == "__main__":
+    # Ctrl-C while the modules below load (about a second): nothing is written yet, so say so and stop
+    # with 130 instead of printing a traceback; main() installs the handler for the run itself.
+    signal.signal(signal.SIGINT, lambda *_: (print("interrupted; nothing written", file=sys.stderr),
+                                             os._exit(130)))
+
+import argparse
 import threading
 import time
 import tomllib

@@ -16,15 +16,23 @@ plus the varied inputs), ``OUT/<sweep>/sweep.csv`` the same table for a spreadsh
 
 from __future__ import annotations
 
+import os
+import signal
+import sys
+
+if __name__ == "__main__":
+    # Ctrl-C while the modules below load (about a second): nothing is written yet, so say so and stop
+    # with 130 instead of printing a traceback; main() installs the handler for the run itself.
+    signal.signal(signal.SIGINT, lambda *_: (print("interrupted; nothing written", file=sys.stderr),
+                                             os._exit(130)))
+
 import argparse
 import contextlib
 import itertools
 import json
 import math
-import os
 import re
 import signal
-import sys
 import tempfile
 import time
 from collections.abc import Sequence

@@ -272,7 +272,7 @@ def test_sweep_checks_stages_and_plot_key_before_running(tmp_path):
 def test_ctrl_c_is_one_line_and_exit_130(tmp_path, module, args):
     """Interrupt at several moments (start-up, cable, FEM, writing): never a traceback."""
     seen = 0
-    for delay in (0.3, 1.0, 2.0, 3.5):
+    for delay in (0.05, 0.3, 1.0, 2.0, 3.5):
         out = tmp_path / f"d{delay}"
         proc = subprocess.Popen([sys.executable, "-m", module, *args, "--out", str(out)], cwd=REPO,
                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
