@@ -36,7 +36,7 @@ def test_direct_theodorsen_frf_equals_closed_form_derivatives_after_conversion()
     K = np.linspace(0.05, 4.0, 57)
     d = derivatives_from_frf(K, Theodorsen().frf(K, 10.0))
     ref = _closed_forms(K)
-    for name in FlutterDerivatives._fields:
+    for name in FlutterDerivatives._fields:   # the ten lateral ones are zero on both sides (no drag)
         np.testing.assert_allclose(getattr(d, name), getattr(ref, name), rtol=1e-12, atol=1e-12, err_msg=name)
 
 
@@ -53,7 +53,7 @@ def test_theodorsen_derivatives_reproduce_check_table(reduced_velocity):
     # H1* = -8.226 and A3* = 4.115 where the closed forms give -8.2255 and 4.1145 (rounding of the source).
     K = 2 * np.pi / reduced_velocity
     d = derivatives_from_frf(np.array([K]), Theodorsen().frf(K, 1.0))
-    for name, printed in zip(FlutterDerivatives._fields, CHECK_TABLE[reduced_velocity], strict=True):
+    for name, printed in zip(FlutterDerivatives._fields[:8], CHECK_TABLE[reduced_velocity], strict=True):
         decimals = len(f"{printed}".split(".")[1])
         assert abs(getattr(d, name)[0] - printed) <= 1.0 * 10.0**-decimals, (name, getattr(d, name)[0], printed)
 
@@ -94,7 +94,7 @@ def test_sign_convention_flips_exactly_four_derivatives():
     h = frf_from_derivatives(K, d)
     up = FRF(h_pu=h.h_pu, h_ptheta=-h.h_ptheta, h_mu=-h.h_mu, h_mtheta=h.h_mtheta)
     flipped = derivatives_from_frf(K, up)
-    signs = {n: np.sign(getattr(flipped, n)[0] / getattr(d, n)[0]) for n in FlutterDerivatives._fields}
+    signs = {n: np.sign(getattr(flipped, n)[0] / getattr(d, n)[0]) for n in FlutterDerivatives._fields[:8]}
     assert {n for n, s in signs.items() if s < 0} == {"H2", "H3", "A1", "A4"}
 
 

@@ -172,7 +172,7 @@ def test_theodorsen_through_scanlan_csv_gives_the_same_critical_speed(tmp_path):
         fh.write("# Theodorsen flat plate, Scanlan convention (h, L down), mid-chord\n")
         w.writerow(["reduced_velocity", "H1*", "H2*", "H3*", "H4*", "A1*", "A2*", "A3*", "A4*"])
         for i in range(K.size):
-            w.writerow([repr(float(2 * np.pi / K[i]))] + [repr(float(getattr(d, n)[i])) for n in d._fields])
+            w.writerow([repr(float(2 * np.pi / K[i]))] + [repr(float(getattr(d, n)[i])) for n in d._fields[:8]])
     table = DerivativeTable.from_csv(path)
     via_csv = solve_pair(section, table, RHO, 3 * selberg_speed(section), min_speed_m_s=0.2 * direct.critical_speed_m_s)
     assert via_csv.flutter
