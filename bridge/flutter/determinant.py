@@ -34,14 +34,22 @@ STRUCTURAL_FORMS = ("derived", "thesis_eq_4_43")
 
 
 def _aero_bracket(model: ModalModel, frf) -> np.ndarray:
-    """[h_pu uu_ij + B h_ptheta ut_ij + B h_mu ut_ji + B^2 h_mtheta tt_ij] with shape (..., N, N)."""
+    """Generalised aerodynamic stiffness per unit (1/2) rho V^2 L, shape (..., N, N):
+    [h_pu uu + h_pr ur + B h_ptheta ut + h_qu ru + h_qr rr + B h_qtheta rt
+     + B h_mu tu + B h_mr tr + B^2 h_mtheta tt]_ij
+    with xy_ij = (1/L) int X_i Y_j (U vertical, R lateral downwind, Theta torsion; ru = ur^T, tu = ut^T,
+    tr = rt^T): the strip loads p, q, m of bridge.flutter.derivatives integrated against mode i."""
     B = model.deck_width_m
 
     def e(h):
         return np.asarray(h)[..., None, None]
 
-    return (e(frf.h_pu) * model.uu + B * e(frf.h_ptheta) * model.ut + B * e(frf.h_mu) * model.ut.T
-            + B**2 * e(frf.h_mtheta) * model.tt)
+    out = (e(frf.h_pu) * model.uu + B * e(frf.h_ptheta) * model.ut + B * e(frf.h_mu) * model.ut.T
+           + B**2 * e(frf.h_mtheta) * model.tt)
+    if model.has_lateral:
+        out = out + (e(frf.h_pr) * model.ur + e(frf.h_qu) * model.ur.T + e(frf.h_qr) * model.rr
+                     + B * e(frf.h_qtheta) * model.rt + B * e(frf.h_mr) * model.rt.T)
+    return out
 
 
 def reduced_matrix(model: ModalModel, aero: AerodynamicModel, air_density: float, omega, speed,
@@ -79,8 +87,10 @@ def dimensional_matrix(model: ModalModel, aero: AerodynamicModel, air_density: f
 
 
 def determinant(D: np.ndarray) -> np.ndarray:
-    """det of a stack of 2x2 matrices: A11 A22 - A12 A21 = f1 + i f2 (Eq 5.15-5.16)."""
-    return D[..., 0, 0] * D[..., 1, 1] - D[..., 0, 1] * D[..., 1, 0]
+    """det of a stack of N x N matrices = f1 + i f2 (Eq 5.15-5.16; 2 x 2: A11 A22 - A12 A21)."""
+    if D.shape[-1] == 2:
+        return D[..., 0, 0] * D[..., 1, 1] - D[..., 0, 1] * D[..., 1, 0]
+    return np.linalg.det(D)
 
 
 @dataclass(frozen=True)
@@ -101,7 +111,7 @@ class FlutterResult:
     max_speed_searched_m_s]; the critical values are then NaN.
     """
 
-    pair: tuple[str, str]
+    pair: tuple[str, ...]
     flutter: bool
     critical_speed_m_s: float
     frequency_hz: float
@@ -114,8 +124,11 @@ class FlutterResult:
 
 
 def _normalised_residual(D: np.ndarray) -> float:
-    """|det| / (|A11 A22| + |A12 A21|): the determinant relative to the size of its terms."""
-    return float(abs(determinant(D)) / (abs(D[0, 0] * D[1, 1]) + abs(D[0, 1] * D[1, 0])))
+    """|det| relative to the size of its terms: |A11 A22 - A12 A21| / (|A11 A22| + |A12 A21|) for two
+    modes; for N modes |det D| / prod_i ||row_i|| (Hadamard's bound, 1 for orthogonal rows)."""
+    if D.shape[-1] == 2:
+        return float(abs(determinant(D)) / (abs(D[0, 0] * D[1, 1]) + abs(D[0, 1] * D[1, 0])))
+    return float(abs(determinant(D)) / np.prod(np.linalg.norm(D, axis=1)))
 
 
 def speed_window(aero, air_density: float, max_speed_m_s: float, min_speed_m_s: float | None) -> tuple[float, float]:
@@ -136,15 +149,16 @@ def solve_pair(model: ModalModel, aero: AerodynamicModel, air_density: float, ma
                min_speed_m_s: float | None = None, n_speed: int = 120, n_omega: int = 241,
                structural_form: str = "derived", tolerance: float = 1e-10,
                max_iterations: int = 50) -> FlutterResult:
-    """Lowest critical speed of a two-mode ``model`` (mode 0 bending, mode 1 torsion, or any two modes).
+    """Lowest critical speed of a two-mode ``model`` (mode 0 bending, mode 1 torsion, or any two modes);
+    a model of more modes (a pair with a lateral mode) is solved the same way on det of its N x N D.
 
     Scan: on a grid of w in [0.25 min w_i, 1.5 max w_i] (Omega = w B / V) and V in [V_min, V_max], find
     the roots of f2 in Omega at each V and the first V step over which f1 at a root changes sign; then
     Newton-Raphson on (f1, f2) = 0 in (Omega, V) with central-difference Jacobian (Eq 5.19-5.21).
     A table-based aerodynamic model that does not cover the needed V range raises InputError.
     """
-    if model.n_modes != 2:
-        raise InputError("flutter.pair", model.labels, "the determinant method takes exactly two modes")
+    if model.n_modes < 2:
+        raise InputError("flutter.pair", model.labels, "the determinant method takes two or more modes")
     v_lo, v_hi = speed_window(aero, air_density, max_speed_m_s, min_speed_m_s)
     B = model.deck_width_m
     wi = model.angular_frequencies
@@ -169,7 +183,7 @@ def solve_pair(model: ModalModel, aero: AerodynamicModel, air_density: float, ma
             out.append((w[i] + t * (w[i + 1] - w[i]), f1[i, col] + t * (f1[i + 1, col] - f1[i, col])))
         return out
 
-    labels = (model.labels[0], model.labels[1])
+    labels = tuple(model.labels)
     dw = w[1] - w[0]
     previous = roots(0)
     for col in range(1, speeds.size):

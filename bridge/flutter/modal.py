@@ -12,7 +12,12 @@ Generalised modal integrals over the whole deck length L (main + side spans), Eq
     uu[i, j] = (1/L) int U_i U_j dz       (a_jj = uu[j, j])
     ut[i, j] = (1/L) int U_i Theta_j dz   (a_jk = ut[j, k])
     tt[i, j] = (1/L) int Theta_i Theta_j dz (a_kk = tt[k, k])
-Modal mass, Eq 4.8/4.33 generalised: m_i = L (mu uu[i, i] + J tt[i, i]).
+and, for lateral motion (R: lateral deck displacement, positive DOWNWIND; the thesis has no lateral
+terms, so they default to zero):
+    rr[i, j] = (1/L) int R_i R_j dz,  ur[i, j] = (1/L) int U_i R_j dz,  rt[i, j] = (1/L) int R_i Theta_j dz
+Modal mass, Eq 4.8/4.33 generalised: m_i = L (mu (uu[i, i] + rr[i, i]) + J tt[i, i]), unless the
+generalised masses are given directly (``generalised_masses``: a modal test or another FE program
+reports them; they must belong to the same mode normalisation as the integrals).
 Source: the thesis, sections 4.1 and 4.4.
 """
 
@@ -61,6 +66,10 @@ class ModalModel:
     inertia_per_length_kg_m2_m: float
     deck_width_m: float
     deck_length_m: float
+    rr: np.ndarray | None = None
+    ur: np.ndarray | None = None
+    rt: np.ndarray | None = None
+    generalised_masses: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         labels = tuple(str(s) for s in self.labels)
@@ -90,26 +99,38 @@ class ModalModel:
             check_range(f"modal.frequencies_hz[{i}]", float(f[i]), low=0.0, low_open=True)
             check_range(f"modal.damping_ratios[{i}]", float(z[i]), low=0.0, high=1.0, high_open=True)
         uu, ut, tt = _matrix("uu", self.uu, n), _matrix("ut", self.ut, n), _matrix("tt", self.tt, n)
-        for name, a in (("uu", uu), ("tt", tt)):
+        zero = np.zeros((n, n))
+        rr, ur, rt = (zero.copy() if getattr(self, k) is None else _matrix(k, getattr(self, k), n)
+                      for k in ("rr", "ur", "rt"))
+        for name, a in (("uu", uu), ("tt", tt), ("rr", rr)):
             if not np.allclose(a, a.T, rtol=1e-9, atol=1e-12):
                 raise InputError(f"modal.{name}", "non-symmetric matrix", "must be symmetric")
             if np.any(np.diag(a) < 0.0):
                 raise InputError(f"modal.{name}", np.diag(a).tolist(), "diagonal must be >= 0")
-        # a lateral mode may have no vertical or torsional component; the others need one (a modal mass)
+        # every mode needs a deck motion (and so a modal mass); a lateral mode given without rr (the
+        # thesis's model) has none and simply takes no part in the aerodynamics
         bad = [labels[i] for i in range(n) if kinds[i] != "lateral" and uu[i, i] + tt[i, i] <= 0.0]
         if bad:
             raise InputError("modal.uu/tt", bad, "every vertical/torsional mode needs uu[i,i] > 0 or tt[i,i] > 0")
+        gm = None
+        if self.generalised_masses is not None:
+            gm = np.asarray(self.generalised_masses, dtype=np.float64).reshape(-1)
+            if gm.shape != (n,):
+                raise InputError("modal.generalised_masses", self.generalised_masses, f"needs one value per mode ({n})")
+            for i in range(n):
+                check_range(f"modal.generalised_masses[{i}]", float(gm[i]), low=0.0, low_open=True)
         mu = check_range("modal.mass_per_length_kg_m", self.mass_per_length_kg_m, low=0.0, low_open=True)
         J = check_range("modal.inertia_per_length_kg_m2_m", self.inertia_per_length_kg_m2_m,
                         low=0.0, low_open=True)
         B = check_range("modal.deck_width_m", self.deck_width_m, low=0.0, low_open=True)
         L = check_range("modal.deck_length_m", self.deck_length_m, low=0.0, low_open=True)
-        for a in (f, z, uu, ut, tt):
+        for a in (f, z, uu, ut, tt, rr, ur, rt) + (() if gm is None else (gm,)):
             a.setflags(write=False)
         for name, value in (("labels", labels), ("kinds", kinds), ("symmetries", syms),
                             ("frequencies_hz", f), ("damping_ratios", z), ("uu", uu), ("ut", ut),
                             ("tt", tt), ("mass_per_length_kg_m", mu), ("inertia_per_length_kg_m2_m", J),
-                            ("deck_width_m", B), ("deck_length_m", L)):
+                            ("deck_width_m", B), ("deck_length_m", L), ("rr", rr), ("ur", ur), ("rt", rt),
+                            ("generalised_masses", gm)):
             object.__setattr__(self, name, value)
 
     # ---------------------------------------------------------------- derived quantities
@@ -123,9 +144,17 @@ class ModalModel:
         return 2.0 * np.pi * self.frequencies_hz
 
     @property
+    def has_lateral(self) -> bool:
+        """True when some mode moves the deck laterally (rr, ur or rt not all zero)."""
+        return bool(np.any(self.rr) or np.any(self.ur) or np.any(self.rt))
+
+    @property
     def modal_masses(self) -> np.ndarray:
-        """Eq 4.8/4.33 generalised: m_i = L (mu uu[i,i] + J tt[i,i])  [kg, or kg m^2 for torsion]."""
-        return self.deck_length_m * (self.mass_per_length_kg_m * np.diag(self.uu)
+        """The given generalised masses, else Eq 4.8/4.33 generalised:
+        m_i = L (mu (uu[i,i] + rr[i,i]) + J tt[i,i])  [kg, or kg m^2 for torsion]."""
+        if self.generalised_masses is not None:
+            return self.generalised_masses
+        return self.deck_length_m * (self.mass_per_length_kg_m * (np.diag(self.uu) + np.diag(self.rr))
                                      + self.inertia_per_length_kg_m2_m * np.diag(self.tt))
 
     def index(self, label: str) -> int:
@@ -170,7 +199,9 @@ class ModalModel:
             damping_ratios=self.damping_ratios[ix], uu=self.uu[np.ix_(ix, ix)], ut=self.ut[np.ix_(ix, ix)],
             tt=self.tt[np.ix_(ix, ix)], mass_per_length_kg_m=self.mass_per_length_kg_m,
             inertia_per_length_kg_m2_m=self.inertia_per_length_kg_m2_m, deck_width_m=self.deck_width_m,
-            deck_length_m=self.deck_length_m)
+            deck_length_m=self.deck_length_m, rr=self.rr[np.ix_(ix, ix)], ur=self.ur[np.ix_(ix, ix)],
+            rt=self.rt[np.ix_(ix, ix)],
+            generalised_masses=None if self.generalised_masses is None else self.generalised_masses[ix])
 
     # ---------------------------------------------------------------- constructors
     @classmethod
@@ -203,20 +234,44 @@ class ModalModel:
     @classmethod
     def section(cls, *, mass_per_length_kg_m: float, inertia_per_length_kg_m2_m: float,
                 heave_frequency_hz: float, pitch_frequency_hz: float, deck_width_m: float,
-                heave_damping_ratio: float = 0.0, pitch_damping_ratio: float = 0.0) -> ModalModel:
-        """A 2-DOF sectional model (rigid section on springs, elastic axis at mid-chord) of unit length.
+                heave_damping_ratio: float = 0.0, pitch_damping_ratio: float = 0.0,
+                lateral_frequency_hz: float | None = None, lateral_damping_ratio: float = 0.0) -> ModalModel:
+        """A 2-DOF sectional model (rigid section on springs, elastic axis at mid-chord) of unit length,
+        or 3-DOF with sway (lateral translation, same mass per length) when ``lateral_frequency_hz`` is set.
 
-        Heave mode: U = 1, Theta = 0; pitch mode: U = 0, Theta = 1.  Hence uu = diag(1, 0),
+        Heave mode: U = 1, Theta = 0; pitch mode: U = 0, Theta = 1; sway mode: R = 1.  Hence uu = diag(1, 0),
         tt = diag(0, 1) and ut[heave, pitch] = (1/L) int U_heave Theta_pitch dz = 1 (a_jk = 1: the
-        aerodynamic coupling is complete; with a_jk = 0 there would be no coupling and no flutter),
-        and the modal masses are the per-unit-length mass and inertia (L = 1 m)."""
-        return cls.from_two_modes(bending_frequency_hz=heave_frequency_hz,
-                                  torsion_frequency_hz=pitch_frequency_hz, a_jj=1.0, a_kk=1.0, a_jk=1.0,
-                                  mass_per_length_kg_m=mass_per_length_kg_m,
-                                  inertia_per_length_kg_m2_m=inertia_per_length_kg_m2_m,
-                                  deck_width_m=deck_width_m, deck_length_m=1.0,
-                                  bending_damping_ratio=heave_damping_ratio,
-                                  torsion_damping_ratio=pitch_damping_ratio, labels=("heave", "pitch"))
+        aerodynamic coupling is complete; with a_jk = 0 there would be no coupling and no flutter), and with
+        sway rr[sway, sway] = ur[heave, sway] = rt[sway, pitch] = 1; the modal masses are the
+        per-unit-length mass and inertia (L = 1 m)."""
+        two = cls.from_two_modes(bending_frequency_hz=heave_frequency_hz,
+                                 torsion_frequency_hz=pitch_frequency_hz, a_jj=1.0, a_kk=1.0, a_jk=1.0,
+                                 mass_per_length_kg_m=mass_per_length_kg_m,
+                                 inertia_per_length_kg_m2_m=inertia_per_length_kg_m2_m,
+                                 deck_width_m=deck_width_m, deck_length_m=1.0,
+                                 bending_damping_ratio=heave_damping_ratio,
+                                 torsion_damping_ratio=pitch_damping_ratio, labels=("heave", "pitch"))
+        if lateral_frequency_hz is None:
+            return two
+        check_range("section.lateral_frequency_hz", lateral_frequency_hz, low=0.0, low_open=True)
+        check_range("section.lateral_damping_ratio", lateral_damping_ratio, low=0.0, high=1.0, high_open=True)
+
+        def grow(a, corner=0.0):
+            out = np.zeros((3, 3))
+            out[:2, :2] = a
+            out[2, 2] = corner
+            return out
+
+        ur, rt = np.zeros((3, 3)), np.zeros((3, 3))
+        ur[0, 2] = 1.0   # heave U against sway R
+        rt[2, 1] = 1.0   # sway R against pitch Theta
+        return cls(labels=("heave", "pitch", "sway"), kinds=("vertical", "torsional", "lateral"),
+                   symmetries=("S", "S", "S"),
+                   frequencies_hz=np.array([heave_frequency_hz, pitch_frequency_hz, lateral_frequency_hz]),
+                   damping_ratios=np.array([heave_damping_ratio, pitch_damping_ratio, lateral_damping_ratio]),
+                   uu=grow(two.uu), ut=grow(two.ut), tt=grow(two.tt), rr=grow(np.zeros((2, 2)), 1.0), ur=ur, rt=rt,
+                   mass_per_length_kg_m=mass_per_length_kg_m, inertia_per_length_kg_m2_m=inertia_per_length_kg_m2_m,
+                   deck_width_m=deck_width_m, deck_length_m=1.0)
 
     # ---------------------------------------------------------------- scenario input
     @classmethod

@@ -2,7 +2,8 @@
 
 Modal equations (Eq 4.9) for all N modes with the aeroelastic modal load of Eq 4.23-4.24:
     M q'' + C q' + K q = A_a(w, V) q,  M = diag(m_i), C = diag(2 m_i zeta_i w_i), K = diag(m_i w_i^2),
-    A_a[i, j] = (1/2) rho V^2 L [h_pu uu_ij + B h_ptheta ut_ij + B h_mu ut_ji + B^2 h_mtheta tt_ij].
+    A_a[i, j] = (1/2) rho V^2 L [h_pu uu_ij + B h_ptheta ut_ij + B h_mu ut_ji + B^2 h_mtheta tt_ij
+                                 + lateral terms, see bridge.flutter.determinant._aero_bracket].
 p-k: for q = Q e^{s t}, A_a is evaluated at the trial frequency w (Omega = w B / V) and split as
 A_a = A_R + i A_I ~ A_R + (A_I / w) s, which is exact on the imaginary axis (s = i w).  Then
     [s^2 M + s (C - A_I / w) + (K - A_R)] Q = 0
@@ -12,7 +13,8 @@ zeta = -Re(s) / |s|, frequency Im(s) / 2 pi.  Flutter: the first V where a dampi
 (refined by Brent's method on zeta(V)); a crossing at zero frequency is static divergence, reported
 apart.  At a flutter point s = i w exactly, so with two modes the p-k
 critical speed is the determinant method's (Eq 4.29) to the iteration tolerance.
-Lateral modes carry no aerodynamic FRF in the thesis's model and are left out.
+Lateral modes carry no aerodynamic FRF in the thesis's model and are left out, unless asked for
+(``lateral=True``, with an aerodynamic model that gives the lateral FRFs).
 """
 
 from __future__ import annotations
@@ -207,10 +209,13 @@ def _damping(s: np.ndarray) -> np.ndarray:
 
 
 def pk_sweep(model: ModalModel, aero: AerodynamicModel, air_density: float, max_speed_m_s: float,
-             min_speed_m_s: float | None = None, n_speed: int = 120, tolerance: float = 1e-10) -> MultimodeResult:
-    """Damping and frequency of every (vertical or torsional) mode for V in [V_min, V_max], and the
-    lowest V where a damping ratio crosses zero from above."""
-    keep = [i for i in range(model.n_modes) if model.kinds[i] != "lateral"]
+             min_speed_m_s: float | None = None, n_speed: int = 120, tolerance: float = 1e-10,
+             lateral: bool = False) -> MultimodeResult:
+    """Damping and frequency of every vertical and torsional mode (and, with ``lateral``, every lateral
+    mode that moves the deck, rr[i, i] > 0) for V in [V_min, V_max], and the lowest V where a damping
+    ratio crosses zero from above."""
+    keep = [i for i in range(model.n_modes) if model.kinds[i] != "lateral"
+            or (lateral and model.rr[i, i] > 0.0)]
     if len(keep) < 2:
         raise InputError("flutter.modes", model.labels, "multimode flutter needs >= 2 vertical/torsional modes")
     model = model.subset(keep)

@@ -7,7 +7,10 @@ Keys (all optional; defaults give a Theodorsen thin-plate analysis up to 150 m/s
     table_group       group inside it (default "/")
     derivatives_path  CSV of Scanlan's H1*..A4* (aerodynamics = "derivatives"), see DerivativeTable
     [flutter.quasi_steady]  lift_coefficient, lift_slope_per_rad, drag_coefficient, moment_coefficient,
-                      moment_slope_per_rad (aerodynamics = "quasi_steady"; all required then)
+                      moment_slope_per_rad (all required), drag_slope_per_rad (default 0): static
+                      coefficients on the reference length B, slopes per radian.  With aerodynamics =
+                      "quasi_steady" they are the whole model; with any other model they supply the
+                      lateral terms (drag, sway) that model lacks (bridge.flutter.aerodynamics.WithLateral)
     air_density_kg_m3 overrides the scenario's [air] density (default: [air], else 1.225)
     max_speed_m_s     highest mean wind speed searched (default 150)
     min_speed_m_s     lowest speed searched (default 1 % of max_speed_m_s, or the table's lowest V)
@@ -24,7 +27,14 @@ from pathlib import Path
 from typing import Any
 
 from bridge.errors import InputError, check_range
-from bridge.flutter.aerodynamics import AerodynamicModel, DerivativeTable, FRFTable, QuasiSteady, Theodorsen
+from bridge.flutter.aerodynamics import (
+    AerodynamicModel,
+    DerivativeTable,
+    FRFTable,
+    QuasiSteady,
+    Theodorsen,
+    WithLateral,
+)
 
 __all__ = ["FlutterOptions", "AERODYNAMIC_MODELS"]
 
@@ -32,6 +42,7 @@ AERODYNAMIC_MODELS = ("theodorsen", "quasi_steady", "table", "derivatives")
 PAIRS = ("thesis", "all")
 _QS_KEYS = ("lift_coefficient", "lift_slope_per_rad", "drag_coefficient", "moment_coefficient",
             "moment_slope_per_rad")
+_QS_OPTIONAL = ("drag_slope_per_rad",)
 
 
 def _number(where: str, key: str, value: Any, **bounds) -> float:
@@ -102,15 +113,16 @@ class FlutterOptions:
             if not isinstance(qs, Mapping):
                 raise InputError(f"{where}.quasi_steady", qs, "must be a table")
             for key in qs:
-                if key not in _QS_KEYS:
+                if key not in _QS_KEYS + _QS_OPTIONAL:
                     raise InputError(f"{where}.quasi_steady.{key}", qs[key],
-                                     f"unknown key; allowed: {', '.join(_QS_KEYS)}")
+                                     f"unknown key; allowed: {', '.join(_QS_KEYS + _QS_OPTIONAL)}")
             missing = [k for k in _QS_KEYS if k not in qs]
             if missing:
                 raise InputError(f"{where}.quasi_steady.{missing[0]}", None, "missing (required key)")
-            for key in _QS_KEYS:
+            given = [k for k in _QS_KEYS + _QS_OPTIONAL if k in qs]
+            for key in given:
                 _number(f"{where}.quasi_steady", key, qs[key], **({"low": 0.0} if key == "drag_coefficient" else {}))
-            values["quasi_steady"] = QuasiSteady(**{k: float(qs[k]) for k in _QS_KEYS})
+            values["quasi_steady"] = QuasiSteady(**{k: float(qs[k]) for k in given})
         for key in ("max_speed_m_s", "min_speed_m_s", "air_density_kg_m3"):
             if key in values:
                 values[key] = _number(where, key, values[key])
@@ -126,13 +138,14 @@ class FlutterOptions:
             q = Path(p)
             return q if q.is_absolute() or base_dir is None else Path(base_dir) / q
 
-        if self.aerodynamics == "theodorsen":
-            return Theodorsen()
-        elif self.aerodynamics == "quasi_steady":
+        if self.aerodynamics == "quasi_steady":
             return self.quasi_steady
+        if self.aerodynamics == "theodorsen":
+            base = Theodorsen()
         elif self.aerodynamics == "table":
-            return FRFTable.from_hdf5(resolve(self.table_path), self.table_group)
+            base = FRFTable.from_hdf5(resolve(self.table_path), self.table_group)
         elif self.aerodynamics == "derivatives":
-            return DerivativeTable.from_csv(resolve(self.derivatives_path))
+            base = DerivativeTable.from_csv(resolve(self.derivatives_path))
         else:
             raise InputError("flutter.aerodynamics", self.aerodynamics, f"one of {', '.join(AERODYNAMIC_MODELS)}")
+        return base if self.quasi_steady is None else WithLateral(base, self.quasi_steady)

@@ -6,8 +6,11 @@ Keys (units in the names):
     pitch_frequency_hz, deck_width_m (B, the chord)                                  - required
     heave_damping_ratio, pitch_damping_ratio (default 0), air_density_kg_m3 and aerodynamics
     (optional overrides of the [air] density and of [flutter].aerodynamics)
+    lateral_frequency_hz, lateral_damping_ratio (optional): a third DOF, sway (lateral translation
+    downwind), with the same mass per length as heave
 The flutter solvers see it as :meth:`ModalModel.section`: uu = diag(1, 0), tt = diag(0, 1),
-ut[heave, pitch] = 1, L = 1 m.
+ut[heave, pitch] = 1, L = 1 m; with sway also rr = 1 on the sway mode, ur[heave, sway] = 1 and
+rt[sway, pitch] = 1 (each DOF is a mode of unit amplitude along the unit length).
 """
 
 from __future__ import annotations
@@ -40,6 +43,8 @@ class SectionModel:
     pitch_damping_ratio: float = 0.0
     air_density_kg_m3: float | None = None
     aerodynamics: str | None = None
+    lateral_frequency_hz: float | None = None
+    lateral_damping_ratio: float = 0.0
 
     def __post_init__(self) -> None:
         self._validate("section")
@@ -50,6 +55,11 @@ class SectionModel:
         for key in _RATIOS:
             object.__setattr__(self, key, check_range(f"{where}.{key}", getattr(self, key), low=0.0, high=1.0,
                                                       high_open=True))
+        if self.lateral_frequency_hz is not None:
+            object.__setattr__(self, "lateral_frequency_hz", check_range(
+                f"{where}.lateral_frequency_hz", self.lateral_frequency_hz, low=0.0, low_open=True))
+        object.__setattr__(self, "lateral_damping_ratio", check_range(
+            f"{where}.lateral_damping_ratio", self.lateral_damping_ratio, low=0.0, high=1.0, high_open=True))
         if self.air_density_kg_m3 is not None:
             object.__setattr__(self, "air_density_kg_m3", check_range(
                 f"{where}.air_density_kg_m3", self.air_density_kg_m3, low=0.0, low_open=True, high=10.0))
@@ -81,4 +91,6 @@ class SectionModel:
                                   heave_frequency_hz=self.heave_frequency_hz,
                                   pitch_frequency_hz=self.pitch_frequency_hz, deck_width_m=self.deck_width_m,
                                   heave_damping_ratio=self.heave_damping_ratio,
-                                  pitch_damping_ratio=self.pitch_damping_ratio)
+                                  pitch_damping_ratio=self.pitch_damping_ratio,
+                                  lateral_frequency_hz=self.lateral_frequency_hz,
+                                  lateral_damping_ratio=self.lateral_damping_ratio)

@@ -91,7 +91,7 @@ def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
 
 
 def _pair_name(r: FlutterResult) -> str:
-    return f"{r.pair[0]}+{r.pair[1]}"
+    return "+".join(r.pair)
 
 
 def _number(x: float) -> float | None:
@@ -110,7 +110,7 @@ def _summary(d: FlutterStageResult, fopts: FlutterOptions) -> dict[str, float | 
         "flutter.reduced_frequency": None if g is None else _number(g.reduced_frequency),
         "flutter.mode_pair": None if g is None else _pair_name(g)}
     for r in d.pairs:
-        key = f"flutter.pair_{r.pair[0]}+{r.pair[1]}"
+        key = f"flutter.pair_{_pair_name(r)}"
         s[f"{key}.critical_speed_m_s"] = _number(r.critical_speed_m_s) if r.flutter else None
         s[f"{key}.frequency_hz"] = _number(r.frequency_hz) if r.flutter else None
     if d.multimode is not None:

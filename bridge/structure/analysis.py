@@ -55,7 +55,13 @@ class FemResult:
     @property
     def modal_model(self):
         """The vertical, torsional and lateral modes as a :class:`bridge.flutter.modal.ModalModel`
-        (integrals of Eq 4.34 over the whole deck length; mu and J of Eq 4.7)."""
+        (integrals of Eq 4.34 over the whole deck length; mu and J of Eq 4.7).
+
+        Wind direction: the flutter convention takes theta nose-up (Eq 4.20), and the FEM's Theta is
+        the rotation theta_z about the bridge axis (right-handed x across, y up, z along), which lifts
+        the edge at +x; so the wind blows from +x towards -x, and the lateral displacement positive
+        DOWNWIND is R = -V (V = u_x).  Hence rr = vv, ur = -uv, rt = -vt.  (The deck and the FEM are
+        symmetric about x = 0, so the other wind direction gives the mirror image and the same speeds.)"""
         from ..flutter.modal import ModalModel  # lazy: the flutter package is optional for this stage
 
         m = self.modes
@@ -66,6 +72,7 @@ class FemResult:
             labels=tuple(m.labels[i] for i in keep), kinds=tuple(m.kinds[i] for i in keep),
             symmetries=tuple(m.symmetries[i] for i in keep), frequencies_hz=m.frequencies_hz[keep],
             damping_ratios=m.damping_ratios[keep], uu=m.uu[ix], ut=m.ut[ix], tt=m.tt[ix],
+            rr=m.vv[ix], ur=-m.uv[ix], rt=-m.vt[ix],
             mass_per_length_kg_m=s.deck_mass_per_length_kg_m,
             inertia_per_length_kg_m2_m=s.deck_inertia_per_length_kg_m2_m,
             deck_width_m=s.girder.width_m, deck_length_m=self.model.deck_length_m)

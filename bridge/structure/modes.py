@@ -88,6 +88,24 @@ class ModeSet:
         w = trapezoid_weights(self.z_m) / self.deck_length_m
         return (self.Theta * w) @ self.Theta.T
 
+    @property
+    def vv(self) -> np.ndarray:
+        """(1/L) int V_i V_j dz: lateral deck displacement (u_x) of mode i against mode j."""
+        w = trapezoid_weights(self.z_m) / self.deck_length_m
+        return (self.V * w) @ self.V.T
+
+    @property
+    def uv(self) -> np.ndarray:
+        """(1/L) int U_i V_j dz."""
+        w = trapezoid_weights(self.z_m) / self.deck_length_m
+        return (self.U * w) @ self.V.T
+
+    @property
+    def vt(self) -> np.ndarray:
+        """(1/L) int V_i Theta_j dz."""
+        w = trapezoid_weights(self.z_m) / self.deck_length_m
+        return (self.V * w) @ self.Theta.T
+
     def index(self, label: str) -> int:
         return self.labels.index(label)
 
