@@ -209,9 +209,12 @@ class ModalModel:
                        a_jj: float, a_kk: float, a_jk: float, mass_per_length_kg_m: float,
                        inertia_per_length_kg_m2_m: float, deck_width_m: float, deck_length_m: float,
                        bending_damping_ratio: float = 0.0, torsion_damping_ratio: float = 0.0,
-                       labels: tuple[str, str] = ("S-V1", "S-T1")) -> ModalModel:
+                       labels: tuple[str, str] = ("S-V1", "S-T1"), bending_modal_mass_kg: float | None = None,
+                       torsion_modal_mass_kg_m2: float | None = None) -> ModalModel:
         """A bending mode j (Theta_j = 0) and a torsional mode k (U_k = 0), Eq 4.30, given a_jj, a_kk,
-        a_jk of Eq 4.34 directly (e.g. the thesis's Table 3.6)."""
+        a_jk of Eq 4.34 directly (e.g. the thesis's Table 3.6).  The modal masses are Eq 4.33's
+        m_j = mu L a_jj, m_k = J L a_kk unless both are given (a modal test or another FE program:
+        ``bending_modal_mass_kg`` for max |U_j| = 1, ``torsion_modal_mass_kg_m2`` for max |Theta_k| = 1)."""
         for key, v in (("a_jj", a_jj), ("a_kk", a_kk), ("bending_frequency_hz", bending_frequency_hz),
                        ("torsion_frequency_hz", torsion_frequency_hz), ("mass_per_length_kg_m", mass_per_length_kg_m),
                        ("inertia_per_length_kg_m2_m", inertia_per_length_kg_m2_m), ("deck_width_m", deck_width_m),
@@ -221,6 +224,14 @@ class ModalModel:
                        ("torsion_damping_ratio", torsion_damping_ratio)):
             check_range(f"modal.{key}", v, low=0.0, high=1.0, high_open=True)
         check_range("modal.a_jk", a_jk)
+        given = (bending_modal_mass_kg, torsion_modal_mass_kg_m2)
+        if (given[0] is None) != (given[1] is None):
+            raise InputError("modal.bending_modal_mass_kg" if given[0] is None else "modal.torsion_modal_mass_kg_m2",
+                             None, "give both modal masses or neither (then Eq 4.33 from mu, J and a_jj, a_kk)")
+        masses = None
+        if given[0] is not None:
+            masses = np.array([check_range("modal.bending_modal_mass_kg", given[0], low=0.0, low_open=True),
+                               check_range("modal.torsion_modal_mass_kg_m2", given[1], low=0.0, low_open=True)])
         ut = np.zeros((2, 2))
         ut[0, 1] = a_jk
         return cls(labels=tuple(labels), kinds=("vertical", "torsional"), symmetries=("S", "S"),
@@ -229,7 +240,7 @@ class ModalModel:
                    uu=np.diag([float(a_jj), 0.0]), ut=ut, tt=np.diag([0.0, float(a_kk)]),
                    mass_per_length_kg_m=mass_per_length_kg_m,
                    inertia_per_length_kg_m2_m=inertia_per_length_kg_m2_m,
-                   deck_width_m=deck_width_m, deck_length_m=deck_length_m)
+                   deck_width_m=deck_width_m, deck_length_m=deck_length_m, generalised_masses=masses)
 
     @classmethod
     def section(cls, *, mass_per_length_kg_m: float, inertia_per_length_kg_m2_m: float,
@@ -277,10 +288,13 @@ class ModalModel:
     @classmethod
     def from_mapping(cls, mapping, where: str = "modal") -> ModalModel:
         """A ``[modal]`` table of a scenario file.  Either the full form (keys = the field names;
-        uu, ut, tt as lists of rows) or the two-mode form of :meth:`from_two_modes` (keys
+        uu, ut, tt as lists of rows; optional rr, ur, rt for lateral motion and generalised_masses, one
+        per mode, to give the modal masses directly) or the two-mode form of :meth:`from_two_modes` (keys
         bending_frequency_hz, torsion_frequency_hz, a_jj, a_kk, a_jk, mass_per_length_kg_m,
         inertia_per_length_kg_m2_m, deck_width_m, deck_length_m, optional bending_damping_ratio,
-        torsion_damping_ratio, labels).  Unknown or missing keys raise InputError naming ``where.key``."""
+        torsion_damping_ratio, labels, bending_modal_mass_kg and torsion_modal_mass_kg_m2).  Unknown or
+        missing keys raise InputError naming ``where.key``."""
+        import dataclasses
         import inspect
         from collections.abc import Mapping
         from dataclasses import fields
@@ -293,7 +307,8 @@ class ModalModel:
             allowed = list(params)
             required = [k for k, p in params.items() if p.default is inspect.Parameter.empty]
         else:
-            allowed = required = [f.name for f in fields(cls)]
+            allowed = [f.name for f in fields(cls)]
+            required = [f.name for f in fields(cls) if f.default is dataclasses.MISSING]
         for key in mapping:
             if key not in allowed:
                 raise InputError(f"{where}.{key}", mapping[key], f"unknown key; allowed: {', '.join(allowed)}")

@@ -207,3 +207,33 @@ def test_bridge_with_a_lateral_torsional_mode_matches_an_independent_calculation
     # the lateral part matters here: without the lateral terms the speed differs
     plain = solve_pair(model, Theodorsen(), RHO, 200.0)
     assert abs(plain.critical_speed_m_s / ours.critical_speed_m_s - 1) > 1e-3
+
+
+def test_modal_scenarios_take_generalised_masses_directly(tmp_path):
+    """kind = "modal" with the modal masses a modal test reports: the two-mode form and the full form give
+    the flutter speed of the same model built from mu, J and the integrals (Eq 4.33) when the masses
+    agree, and a different one when they do not."""
+    from bridge.config import load_scenario
+    from bridge.errors import InputError
+
+    base = dict(bending_frequency_hz=0.1, torsion_frequency_hz=0.28, a_jj=0.308, a_kk=0.239, a_jk=0.2,
+                mass_per_length_kg_m=23_000.0, inertia_per_length_kg_m2_m=2.5e6, deck_width_m=31.0,
+                deck_length_m=2694.0, bending_damping_ratio=0.005, torsion_damping_ratio=0.003)
+    eq_4_33 = ModalModel.from_mapping(base)
+    m_j, m_k = eq_4_33.modal_masses
+    given = ModalModel.from_mapping({**base, "bending_modal_mass_kg": m_j, "torsion_modal_mass_kg_m2": m_k})
+    heavier = ModalModel.from_mapping({**base, "bending_modal_mass_kg": m_j, "torsion_modal_mass_kg_m2": 2 * m_k})
+    v = [solve_pair(m, Theodorsen(), RHO, 300.0).critical_speed_m_s for m in (eq_4_33, given, heavier)]
+    assert v[1] == pytest.approx(v[0], rel=1e-12) and v[2] > 1.1 * v[0]
+    with pytest.raises(InputError, match="torsion_modal_mass_kg_m2"):
+        ModalModel.from_mapping({**base, "bending_modal_mass_kg": m_j})
+    # the full form, read from a scenario file, with generalised_masses and lateral integrals
+    f = tmp_path / "tested_modes.toml"
+    f.write_text('kind = "modal"\n[modal]\nlabels = ["S-V1", "S-T1"]\nkinds = ["vertical", "torsional"]\n'
+                 'symmetries = ["S", "S"]\nfrequencies_hz = [0.1, 0.28]\ndamping_ratios = [0.005, 0.003]\n'
+                 'uu = [[0.308, 0.0], [0.0, 0.0]]\nut = [[0.0, 0.2], [0.0, 0.0]]\ntt = [[0.0, 0.0], [0.0, 0.239]]\n'
+                 'rr = [[0.0, 0.0], [0.0, 0.0]]\n'
+                 f'generalised_masses = [{float(m_j)!r}, {float(2 * m_k)!r}]\nmass_per_length_kg_m = 23000.0\n'
+                 'inertia_per_length_kg_m2_m = 2.5e6\ndeck_width_m = 31.0\ndeck_length_m = 2694.0\n')
+    sc = load_scenario(f)
+    assert solve_pair(sc.modal, Theodorsen(), RHO, 300.0).critical_speed_m_s == pytest.approx(v[2], rel=1e-12)
