@@ -95,6 +95,11 @@ def headline(summary: Mapping[str, Any]) -> list[str]:
         if "flutter.multimode_critical_speed_m_s" in s:
             mm = _fmt(s.get("flutter.multimode_critical_speed_m_s"), ".1f", " m/s")
             lines.append(f"multimode p-k V_c = {mm}" if mm else "multimode p-k: no flutter in the speeds searched")
+        if "flutter.multimode_with_lateral_critical_speed_m_s" in s:
+            ml = _fmt(s.get("flutter.multimode_with_lateral_critical_speed_m_s"), ".1f", " m/s")
+            pct = _fmt(s.get("flutter.multimode_lateral_effect_percent"), "+.1f", " %")
+            lines.append(f"with the lateral modes: multimode p-k V_c = {ml}" + (f" ({pct})" if pct else "")
+                         if ml else "with the lateral modes: no multimode flutter in the speeds searched")
         if "flutter.divergence_speed_m_s" in s:
             dv = _fmt(s.get("flutter.divergence_speed_m_s"), ".1f", " m/s")
             lines.append(f"static divergence at V = {dv}" if dv else "no static divergence in the speeds searched")

@@ -24,6 +24,7 @@ from typing import Any
 import numpy as np
 
 from bridge.errors import InputError
+from bridge.flutter.aerodynamics import has_lateral
 from bridge.flutter.determinant import FlutterResult, governing, solve_pair
 from bridge.flutter.modal import ModalModel
 from bridge.flutter.multimode import MultimodeResult, pk_sweep
@@ -31,7 +32,7 @@ from bridge.flutter.options import FlutterOptions
 from bridge.results import write_dataset
 from bridge.stages import RunOptions, StageOutput
 
-__all__ = ["run", "FlutterStageResult"]
+__all__ = ["run", "FlutterStageResult", "LateralEffect"]
 
 QUICK_SPEED_STEPS = 40
 
@@ -46,6 +47,39 @@ class FlutterStageResult:
     pairs: tuple[FlutterResult, ...]
     governing: FlutterResult | None
     multimode: MultimodeResult | None
+    lateral: LateralEffect | None = None
+
+
+@dataclass(frozen=True)
+class LateralEffect:
+    """The flutter analysis again with the lateral modes, when the aerodynamics give lateral terms.
+
+    ``mode``: the lateral mode added to the governing pair (the one of its symmetry most coupled to the
+    pair's torsional mode, |rt| / sqrt(rr tt)); ``governing``: that three-mode determinant solution;
+    ``multimode``: the p-k sweep over the vertical, torsional and lateral modes."""
+
+    mode: str | None
+    governing: FlutterResult | None
+    multimode: MultimodeResult | None
+
+
+def _lateral_effect(modal: ModalModel, aero: Any, rho: float, gov: FlutterResult | None, fopts: FlutterOptions,
+                    kw: dict) -> LateralEffect | None:
+    """:class:`LateralEffect`, or None when the modes or the aerodynamics have no lateral part."""
+    lateral = [i for i in range(modal.n_modes) if modal.kinds[i] == "lateral" and modal.rr[i, i] > 0.0]
+    if not (lateral and modal.has_lateral and has_lateral(aero)):
+        return None
+    triple, mode = None, None
+    if gov is not None:
+        j, k = modal.index(gov.pair[0]), modal.index(gov.pair[1])
+        same = [i for i in lateral if modal.symmetries[i] == modal.symmetries[k]]
+        if same:
+            link = [abs(modal.rt[i, k]) / np.sqrt(modal.rr[i, i] * max(modal.tt[k, k], 1e-300)) for i in same]
+            lat = same[int(np.argmax(link))]
+            mode = modal.labels[lat]
+            triple = solve_pair(modal.subset([j, k, lat]), aero, rho, fopts.max_speed_m_s, **kw)
+    mm = pk_sweep(modal, aero, rho, fopts.max_speed_m_s, lateral=True, **kw) if fopts.multimode else None
+    return LateralEffect(mode, triple, mm)
 
 
 def _modes(scenario: Any, upstream: dict) -> tuple[ModalModel, str]:
@@ -84,7 +118,10 @@ def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
                   for p in modal.pairs(fopts.pairs))
     gov = governing(list(pairs))
     mm = pk_sweep(modal, aero, rho, fopts.max_speed_m_s, **kw) if fopts.multimode else None
-    data = FlutterStageResult(modal, aero.name, rho, pairs, gov, mm)
+    lateral = _lateral_effect(modal, aero, rho, gov, fopts, kw)
+    if lateral is not None:
+        options.say(f"flutter: again with the lateral modes ({aero.name})")
+    data = FlutterStageResult(modal, aero.name, rho, pairs, gov, mm, lateral)
     return StageOutput(summary=_summary(data, fopts), write_h5=lambda g: _write_h5(g, data),
                        report=_report(data, source, fopts),
                        figures={**_mode_shape_figures(data, upstream), **_figures(data)}, data=data)
@@ -117,7 +154,53 @@ def _summary(d: FlutterStageResult, fopts: FlutterOptions) -> dict[str, float | 
         m = d.multimode
         s["flutter.multimode_critical_speed_m_s"] = _number(m.critical_speed_m_s) if m.flutter else None
         s["flutter.divergence_speed_m_s"] = _number(m.divergence_speed_m_s)
+    s.update(_lateral_summary(d))
     return s
+
+
+def _lateral_report(d: FlutterStageResult) -> list[str]:
+    lat = d.lateral
+    if lat is None:
+        return []
+    s = _lateral_summary(d)
+    lines = ["", "**Lateral modes.** The aerodynamics give lateral terms (drag, sway; Scanlan's P*, H5*, H6*, "
+             "A5*, A6*), so the analysis is repeated with the lateral modes that move the deck "
+             "(docs/flutter.md, lateral motion)."]
+    if lat.governing is not None:
+        g = lat.governing
+        pct = s.get("flutter.pair_lateral_effect_percent")
+        lines.append(f"Governing pair with its most coupled lateral mode {lat.mode}: " + (
+            f"V_c = {g.critical_speed_m_s:.2f} m/s, f_c = {g.frequency_hz:.4f} Hz"
+            + (f" ({pct:+.2f} % against the pair alone)." if pct is not None else ".")
+            if g.flutter else f"no flutter below {g.max_speed_searched_m_s:g} m/s."))
+    if lat.multimode is not None:
+        m = lat.multimode
+        pct = s.get("flutter.multimode_lateral_effect_percent")
+        lines.append(f"Multimode p-k with {len(m.labels)} modes including the lateral ones: " + (
+            f"V_c = {m.critical_speed_m_s:.2f} m/s in mode {m.unstable_mode}"
+            + (f" ({pct:+.2f} % against vertical and torsional modes only)." if pct is not None else ".")
+            if m.flutter else f"no flutter below {m.max_speed_searched_m_s:g} m/s."))
+    return lines
+
+
+def _lateral_summary(d: FlutterStageResult) -> dict[str, float | str | None]:
+    """The V_c with the lateral modes and their effect in per cent (present only when computed)."""
+    lat = d.lateral
+    if lat is None:
+        return {}
+    out: dict[str, float | str | None] = {"flutter.lateral_mode": lat.mode}
+    if lat.governing is not None:
+        v = lat.governing.critical_speed_m_s if lat.governing.flutter else math.nan
+        out["flutter.pair_with_lateral_critical_speed_m_s"] = _number(v)
+        if d.governing is not None:
+            out["flutter.pair_lateral_effect_percent"] = _number(100.0 * (v / d.governing.critical_speed_m_s - 1))
+    if lat.multimode is not None:
+        v = lat.multimode.critical_speed_m_s if lat.multimode.flutter else math.nan
+        out["flutter.multimode_with_lateral_critical_speed_m_s"] = _number(v)
+        if d.multimode is not None and d.multimode.flutter:
+            out["flutter.multimode_lateral_effect_percent"] = _number(
+                100.0 * (v / d.multimode.critical_speed_m_s - 1))
+    return out
 
 
 def _text(group: Any, name: str, values: Any, description: str) -> None:
@@ -185,31 +268,46 @@ def _write_h5(group: Any, d: FlutterStageResult) -> None:
                           f"({shape}) {part} part of det D(Omega, V), the reduced determinant of pair "
                           f"{_pair_name(shown)} (Eq 5.15-5.16); NaN outside a table's range")
     if d.multimode is not None:
-        mm = d.multimode
-        nv, nm = mm.damping_ratio.shape
-        g = group.create_group("multimode")
-        _text(g, "labels", mm.labels, f"({nm},) vertical and torsional modes of the p-k sweep (columns below)")
-        write_dataset(g, "speed_m_s", mm.speed_m_s, "m/s", f"({nv},) wind speeds of the sweep (rows below)")
-        write_dataset(g, "frequency_hz", mm.frequency_hz, "Hz",
-                      f"({nv}, {nm}) [speed, mode] p-k frequency Im(s) / 2 pi; 0 on a non-oscillatory "
-                      "branch (real eigenvalue); NaN where the mode left the aerodynamic model's range or "
-                      "found no root")
-        write_dataset(g, "damping_ratio", mm.damping_ratio, "1",
-                      f"({nv}, {nm}) [speed, mode] total (structural + aerodynamic) damping ratio "
-                      "-Re(s) / |s|; exactly +1 (decaying) or -1 (growing: static divergence) on a "
-                      "non-oscillatory branch (real eigenvalue, frequency 0); NaN as for frequency_hz")
-        g.attrs["flutter"] = int(mm.flutter)
-        g.attrs["critical_speed_m_s"] = mm.critical_speed_m_s
-        g.attrs["frequency_hz"] = mm.frequency_hz_at_flutter
-        g.attrs["reduced_frequency"] = mm.reduced_frequency
-        g.attrs["unstable_mode"] = mm.unstable_mode
-        g.attrs["divergence_speed_m_s"] = mm.divergence_speed_m_s
-        g.attrs["unresolved_points"] = len(mm.unresolved)
-        if mm.unresolved:
-            _text(g, "unresolved_mode", [u[0] for u in mm.unresolved],
-                  "modes whose p-k iteration found no root on the tracked branch (NaN in the sweep)")
-            write_dataset(g, "unresolved_speed_m_s", [u[1] for u in mm.unresolved], "m/s",
-                          "wind speeds of those points, one per unresolved_mode entry")
+        _write_multimode(group.create_group("multimode"), d.multimode, "vertical and torsional modes")
+    if d.lateral is not None:
+        lat = d.lateral
+        g = group.create_group("lateral")
+        g.attrs["lateral_mode"] = lat.mode or ""
+        if lat.governing is not None:
+            g.attrs["pair_with_lateral"] = _pair_name(lat.governing)
+            g.attrs["pair_with_lateral_flutter"] = int(lat.governing.flutter)
+            g.attrs["pair_with_lateral_critical_speed_m_s"] = lat.governing.critical_speed_m_s
+            g.attrs["pair_with_lateral_frequency_hz"] = lat.governing.frequency_hz
+        if lat.multimode is not None:
+            _write_multimode(g.create_group("multimode"), lat.multimode,
+                             "vertical, torsional and lateral modes")
+
+
+def _write_multimode(g: Any, mm: MultimodeResult, which: str) -> None:
+    """One p-k sweep into group ``g`` (``/flutter/multimode``, ``/flutter/lateral/multimode``)."""
+    nv, nm = mm.damping_ratio.shape
+    _text(g, "labels", mm.labels, f"({nm},) {which} of the p-k sweep (columns below)")
+    write_dataset(g, "speed_m_s", mm.speed_m_s, "m/s", f"({nv},) wind speeds of the sweep (rows below)")
+    write_dataset(g, "frequency_hz", mm.frequency_hz, "Hz",
+                  f"({nv}, {nm}) [speed, mode] p-k frequency Im(s) / 2 pi; 0 on a non-oscillatory "
+                  "branch (real eigenvalue); NaN where the mode left the aerodynamic model's range or "
+                  "found no root")
+    write_dataset(g, "damping_ratio", mm.damping_ratio, "1",
+                  f"({nv}, {nm}) [speed, mode] total (structural + aerodynamic) damping ratio "
+                  "-Re(s) / |s|; exactly +1 (decaying) or -1 (growing: static divergence) on a "
+                  "non-oscillatory branch (real eigenvalue, frequency 0); NaN as for frequency_hz")
+    g.attrs["flutter"] = int(mm.flutter)
+    g.attrs["critical_speed_m_s"] = mm.critical_speed_m_s
+    g.attrs["frequency_hz"] = mm.frequency_hz_at_flutter
+    g.attrs["reduced_frequency"] = mm.reduced_frequency
+    g.attrs["unstable_mode"] = mm.unstable_mode
+    g.attrs["divergence_speed_m_s"] = mm.divergence_speed_m_s
+    g.attrs["unresolved_points"] = len(mm.unresolved)
+    if mm.unresolved:
+        _text(g, "unresolved_mode", [u[0] for u in mm.unresolved],
+              "modes whose p-k iteration found no root on the tracked branch (NaN in the sweep)")
+        write_dataset(g, "unresolved_speed_m_s", [u[1] for u in mm.unresolved], "m/s",
+                      "wind speeds of those points, one per unresolved_mode entry")
 
 
 def _report(d: FlutterStageResult, source: str, fopts: FlutterOptions) -> str:
@@ -232,6 +330,7 @@ def _report(d: FlutterStageResult, source: str, fopts: FlutterOptions) -> str:
                      f"f_c = {g.frequency_hz:.4f} Hz, Omega_c = {g.reduced_frequency:.4f}.")
     else:
         lines.append(f"**No flutter** of any pair below {fopts.max_speed_m_s:g} m/s.")
+    lines += _lateral_report(d)
     if d.multimode is not None:
         m = d.multimode
         lines += ["", f"Multimode p-k with {len(m.labels)} modes ({', '.join(m.labels)}): " + (
