@@ -222,12 +222,16 @@ def _write_h5(group: Any, d: FlutterStageResult) -> None:
                   f"({n},) undamped natural frequencies f_i")
     write_dataset(g, "damping_ratios", np.asarray(m.damping_ratios, dtype=np.float64), "1",
                   f"({n},) structural damping ratios zeta_i")
-    for name, what in (("uu", "U_i U_j"), ("ut", "U_i Theta_j"), ("tt", "Theta_i Theta_j")):
+    for name, what in (("uu", "U_i U_j"), ("ut", "U_i Theta_j"), ("tt", "Theta_i Theta_j"),
+                       ("rr", "R_i R_j"), ("ur", "U_i R_j"), ("rt", "R_i Theta_j")):
         write_dataset(g, name, np.asarray(getattr(m, name), dtype=np.float64), "1",
-                      f"({n}, {n}) (1/L) int {what} dz over the deck length L (Eq 4.34)")
+                      f"({n}, {n}) (1/L) int {what} dz over the deck length L (Eq 4.34; R: lateral deck "
+                      "displacement, positive downwind)")
+    given = m.generalised_masses is not None
     write_dataset(g, "modal_masses", np.asarray(m.modal_masses, dtype=np.float64), "kg or kg m^2",
-                  f"({n},) m_i = L (mu uu_ii + J tt_ii) (Eq 4.33): kg for vertical and lateral modes, "
-                  "kg m^2 for torsional modes")
+                  f"({n},) " + ("generalised masses as given in [modal]" if given else
+                                "m_i = L (mu (uu_ii + rr_ii) + J tt_ii) (Eq 4.33 with the lateral motion)")
+                  + ": kg for vertical and lateral modes, kg m^2 for torsional modes")
     for name in ("mass_per_length_kg_m", "inertia_per_length_kg_m2_m", "deck_width_m", "deck_length_m"):
         g.attrs[name] = getattr(m, name)
     p = group.create_group("pairs")
