@@ -108,7 +108,13 @@ class FlutterResult:
     """Outcome of the two-mode determinant method for one (bending, torsion) pair.
 
     ``flutter`` False means no solution was found for V in [min_speed_searched_m_s,
-    max_speed_searched_m_s]; the critical values are then NaN.
+    max_speed_searched_m_s]; the critical values are then NaN.  Where the aerodynamic model is a table:
+    ``covered_omega_range`` is its Omega range ((0, inf) for a closed form), ``scan_covered`` False when
+    part of the scan (w in [0.25 min w_i, 1.5 max w_i] at each V) lay outside it, and
+    ``uncovered_speeds_m_s`` the intervals of searched speeds at which the data do not cover the pair's
+    natural frequencies [min w_i, max w_i] (Omega = w B / V outside the range: no root searched there).
+    ``no_root_in_covered_range``: no flutter found where the model has data - not "no flutter below
+    max_speed_searched_m_s".
     """
 
     pair: tuple[str, ...]
@@ -121,6 +127,14 @@ class FlutterResult:
     min_speed_searched_m_s: float
     max_speed_searched_m_s: float
     scan: DeterminantMap | None = field(default=None, repr=False, compare=False)
+    covered_omega_range: tuple[float, float] = (0.0, np.inf)
+    scan_covered: bool = True
+    uncovered_speeds_m_s: tuple[tuple[float, float], ...] = ()
+
+    @property
+    def no_root_in_covered_range(self) -> bool:
+        """No flutter found, and the aerodynamic data did not cover the whole search."""
+        return not self.flutter and not self.scan_covered
 
 
 def _normalised_residual(D: np.ndarray) -> float:
@@ -155,7 +169,10 @@ def solve_pair(model: ModalModel, aero: AerodynamicModel, air_density: float, ma
     Scan: on a grid of w in [0.25 min w_i, 1.5 max w_i] (Omega = w B / V) and V in [V_min, V_max], find
     the roots of f2 in Omega at each V and the first V step over which f1 at a root changes sign; then
     Newton-Raphson on (f1, f2) = 0 in (Omega, V) with central-difference Jacobian (Eq 5.19-5.21).
-    A table-based aerodynamic model that does not cover the needed V range raises InputError.
+    A table-based aerodynamic model that does not cover the needed V range raises InputError.  Scan points
+    outside the model's Omega range are NaN in both f1 and f2 (no sign change, so no root, across the
+    border of the covered region); the result gives the table's range, the speeds at which it misses the
+    pair's natural frequencies (``uncovered_speeds_m_s``) and, without a root, ``no_root_in_covered_range``.
     """
     if model.n_modes < 2:
         raise InputError("flutter.pair", model.labels, "the determinant method takes two or more modes")
@@ -167,7 +184,7 @@ def solve_pair(model: ModalModel, aero: AerodynamicModel, air_density: float, ma
     Om = w[:, None] * B / speeds[None, :]
     o_lo, o_hi = aero.omega_range
     inside = (Om >= o_lo) & (Om <= o_hi)
-    f = np.full(Om.shape, np.nan + 0j)
+    f = np.full(Om.shape, complex(np.nan, np.nan))   # outside the model: NaN in f1 AND f2 (nan + 0j had f2 = 0)
     if np.any(inside):
         Vg = np.broadcast_to(speeds, Om.shape)
         f[inside] = determinant(reduced_matrix(model, aero, air_density, Om[inside], Vg[inside], structural_form))
@@ -184,6 +201,15 @@ def solve_pair(model: ModalModel, aero: AerodynamicModel, air_density: float, ma
         return out
 
     labels = tuple(model.labels)
+    # the data cover the natural frequencies [min w_i, max w_i] for B max w_i / o_hi <= V <= B min w_i / o_lo
+    v_a = B * wi.max() / o_hi if o_hi > 0 else np.inf
+    v_b = B * wi.min() / o_lo if o_lo > 0 else np.inf
+    gaps = [(v_lo, min(v_a, v_hi))] if v_a > v_lo else []
+    gaps += [(max(v_b, v_lo), v_hi)] if v_b < v_hi else []
+    if v_a > v_b:                                           # nowhere covered: one gap, the whole window
+        gaps = [(v_lo, v_hi)]
+    coverage = dict(covered_omega_range=(float(o_lo), float(o_hi)), scan_covered=bool(np.all(inside)),
+                    uncovered_speeds_m_s=tuple((float(a), float(b)) for a, b in gaps))
     dw = w[1] - w[0]
     previous = roots(0)
     for col in range(1, speeds.size):
@@ -204,15 +230,14 @@ def solve_pair(model: ModalModel, aero: AerodynamicModel, air_density: float, ma
                 return FlutterResult(pair=labels, flutter=True, critical_speed_m_s=V_c,
                                      frequency_hz=Om_c * V_c / B / (2 * np.pi), reduced_frequency=Om_c,
                                      iterations=it, residual=r, min_speed_searched_m_s=float(v_lo),
-                                     max_speed_searched_m_s=float(v_hi), scan=scan)
+                                     max_speed_searched_m_s=float(v_hi), scan=scan, **coverage)
         previous = current
-    if not np.all(inside):
-        raise InputError("flutter.reduced_frequency", (float(np.nanmin(Om)), float(np.nanmax(Om))),
-                         f"no flutter found where the aerodynamic model covers Omega in [{o_lo:g}, {o_hi:g}], "
-                         "but the search needs the range shown; cannot conclude without extrapolating")
+    # no root: "no flutter below v_hi" if the model covered the whole scan, else "no root in the covered
+    # range" (FlutterResult.no_root_in_covered_range); never extrapolated, never an error for the stage
     return FlutterResult(pair=labels, flutter=False, critical_speed_m_s=np.nan, frequency_hz=np.nan,
                          reduced_frequency=np.nan, iterations=0, residual=np.nan,
-                         min_speed_searched_m_s=float(v_lo), max_speed_searched_m_s=float(v_hi), scan=scan)
+                         min_speed_searched_m_s=float(v_lo), max_speed_searched_m_s=float(v_hi), scan=scan,
+                         **coverage)
 
 
 def _newton(model, aero, rho, Om0, V0, form, tol, max_iterations, v_window):

@@ -5,7 +5,13 @@ Keys (all optional; defaults give a Theodorsen thin-plate analysis up to 150 m/s
     table_path        HDF5 file of h_xy(Omega, V) (aerodynamics = "table"); relative paths are taken
                       from the scenario file's folder.  Schema: docs/results.md "Aerodynamic table (input)"
     table_group       group inside it (default "/")
-    derivatives_path  CSV of Scanlan's H1*..A4* (aerodynamics = "derivatives"), see DerivativeTable
+    derivatives_path  CSV of flutter derivatives H1*-H6*, A1*-A6*, P1*-P6* (aerodynamics = "derivatives"),
+                      in the convention it states (bridge.flutter.tables.DerivativeTable)
+    [flutter.derivatives_convention]  vertical, lift, lateral, drag, pitch, moment, reference_length: the
+                      table's convention (bridge.flutter.conventions); merged with the CSV's
+                      ``# convention:`` line, a key stated differently by the two is an error
+    missing_derivatives  "error" | "zero": a derivative column the table lacks (H1-H4, A1-A4, or the partner
+                      of a lateral one it has) is an error, or zero (default "error")
     [flutter.quasi_steady]  lift_coefficient, lift_slope_per_rad, drag_coefficient, moment_coefficient,
                       moment_slope_per_rad (all required), drag_slope_per_rad (default 0): static
                       coefficients on the reference length B, slopes per radian.  With aerodynamics =
@@ -35,6 +41,8 @@ from bridge.flutter.aerodynamics import (
     Theodorsen,
     WithLateral,
 )
+from bridge.flutter.conventions import Convention
+from bridge.flutter.tables import MISSING_DERIVATIVES
 
 __all__ = ["FlutterOptions", "AERODYNAMIC_MODELS"]
 
@@ -65,6 +73,8 @@ class FlutterOptions:
     table_path: str | None = None
     table_group: str = "/"
     derivatives_path: str | None = None
+    derivatives_convention: Convention | None = None
+    missing_derivatives: str = "error"
     quasi_steady: QuasiSteady | None = None
     air_density_kg_m3: float | None = None
     max_speed_m_s: float = 150.0
@@ -80,6 +90,10 @@ class FlutterOptions:
         _string(where, "aerodynamics", self.aerodynamics, AERODYNAMIC_MODELS)
         _string(where, "pairs", self.pairs, PAIRS)
         _string(where, "table_group", self.table_group)
+        _string(where, "missing_derivatives", self.missing_derivatives, MISSING_DERIVATIVES)
+        if self.derivatives_convention is not None and not isinstance(self.derivatives_convention, Convention):
+            raise InputError(f"{where}.derivatives_convention", self.derivatives_convention,
+                             "a table of vertical, lift, lateral, drag, pitch, moment, reference_length")
         _number(where, "max_speed_m_s", self.max_speed_m_s, low=0.0, low_open=True)
         if self.min_speed_m_s is not None:
             _number(where, "min_speed_m_s", self.min_speed_m_s, low=0.0, low_open=True,
@@ -108,6 +122,9 @@ class FlutterOptions:
             if key not in allowed:
                 raise InputError(f"{where}.{key}", mapping[key], f"unknown key; allowed: {', '.join(allowed)}")
         values = dict(mapping)
+        if "derivatives_convention" in values:
+            values["derivatives_convention"] = Convention.from_mapping(values["derivatives_convention"],
+                                                                       f"{where}.derivatives_convention")
         if "quasi_steady" in values:
             qs = values["quasi_steady"]
             if not isinstance(qs, Mapping):
@@ -145,7 +162,8 @@ class FlutterOptions:
         elif self.aerodynamics == "table":
             base = FRFTable.from_hdf5(resolve(self.table_path), self.table_group)
         elif self.aerodynamics == "derivatives":
-            base = DerivativeTable.from_csv(resolve(self.derivatives_path))
+            base = DerivativeTable.from_csv(resolve(self.derivatives_path), convention=self.derivatives_convention,
+                                            missing=self.missing_derivatives)
         else:
             raise InputError("flutter.aerodynamics", self.aerodynamics, f"one of {', '.join(AERODYNAMIC_MODELS)}")
         return base if self.quasi_steady is None else WithLateral(base, self.quasi_steady)

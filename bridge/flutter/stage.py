@@ -150,6 +150,7 @@ def _summary(d: FlutterStageResult, fopts: FlutterOptions) -> dict[str, float | 
         key = f"flutter.pair_{_pair_name(r)}"
         s[f"{key}.critical_speed_m_s"] = _number(r.critical_speed_m_s) if r.flutter else None
         s[f"{key}.frequency_hz"] = _number(r.frequency_hz) if r.flutter else None
+        s[f"{key}.no_root_in_covered_range"] = r.no_root_in_covered_range   # a table's range, not "no flutter"
     if d.multimode is not None:
         m = d.multimode
         s["flutter.multimode_critical_speed_m_s"] = _number(m.critical_speed_m_s) if m.flutter else None
@@ -325,13 +326,34 @@ def _report(d: FlutterStageResult, source: str, fopts: FlutterOptions) -> str:
         if r.flutter:
             lines.append(f"| {_pair_name(r)} | yes | {r.critical_speed_m_s:.2f} | {r.frequency_hz:.4f} | "
                          f"{r.reduced_frequency:.4f} | {r.iterations} | {r.residual:.1e} |")
+        elif r.no_root_in_covered_range:
+            o_lo, o_hi = r.covered_omega_range
+            lines.append(f"| {_pair_name(r)} | no root in the covered range (Omega {o_lo:.4g}-{o_hi:.4g}, "
+                         f"V {r.min_speed_searched_m_s:g}-{r.max_speed_searched_m_s:g} m/s) | | | | | |")
         else:
             lines.append(f"| {_pair_name(r)} | none below {r.max_speed_searched_m_s:g} m/s | | | | | |")
     lines.append("")
+    # where a table's Omega range left part of the search without data: which speeds, for which pair
+    gaps = [r for r in d.pairs if not r.scan_covered]
+    if gaps:
+        o_lo, o_hi = gaps[0].covered_omega_range
+        lines.append(f"The aerodynamic data cover Omega = w B / V in [{o_lo:.4g}, {o_hi:.4g}] only; no root is "
+                     "searched outside (never extrapolated).  Speeds at which they do not cover the natural "
+                     "frequencies of a pair (Omega outside the range for some f between the pair's two):")
+        for r in gaps:
+            f = [d.modal_model.frequencies_hz[d.modal_model.index(lab)] for lab in r.pair]
+            where = ", ".join(f"{a:.1f}-{b:.1f} m/s" for a, b in r.uncovered_speeds_m_s) or "none"
+            lines.append(f"* {_pair_name(r)} ({min(f):.4f}-{max(f):.4f} Hz): {where}"
+                         + ("; no root in the covered range." if r.no_root_in_covered_range else "."))
+        lines.append("")
     if d.governing is not None:
         g = d.governing
         lines.append(f"Governing pair {_pair_name(g)}: **V_c = {g.critical_speed_m_s:.2f} m/s**, "
-                     f"f_c = {g.frequency_hz:.4f} Hz, Omega_c = {g.reduced_frequency:.4f}.")
+                     f"f_c = {g.frequency_hz:.4f} Hz, Omega_c = {g.reduced_frequency:.4f}"
+                     + (" (the lowest root found; see the speeds without data above)." if gaps else "."))
+    elif gaps:
+        lines.append(f"**No flutter found** where the aerodynamic data reach (up to {fopts.max_speed_m_s:g} m/s); "
+                     "that is not 'no flutter': see the speeds without data above.")
     else:
         lines.append(f"**No flutter** of any pair below {fopts.max_speed_m_s:g} m/s.")
     lines += _lateral_report(d)

@@ -1,24 +1,40 @@
 """Aerodynamic models read from tables: h_xy tabulated over (Omega, V) in HDF5 (:class:`FRFTable`, e.g.
-written by the CFD stage) and Scanlan's flutter derivatives against reduced velocity or K in CSV
-(:class:`DerivativeTable`, e.g. a wind-tunnel report).  Both implement
-:class:`bridge.flutter.aerodynamics.AerodynamicModel` and are never extrapolated: asking outside a
-table's range raises InputError.
+written by the CFD stage) and flutter derivatives against a reduced frequency or velocity in CSV
+(:class:`DerivativeTable`, e.g. a wind-tunnel report, in the convention the table states; see
+:mod:`bridge.flutter.conventions`).  Both implement :class:`bridge.flutter.aerodynamics.AerodynamicModel`,
+list in ``provides`` the FRFs they really give (the others are zero, for another model to fill), and are
+never extrapolated: asking outside a table's range raises InputError.
 """
 
 from __future__ import annotations
 
 import csv
+import warnings
 from pathlib import Path
 
 import numpy as np
 from scipy.interpolate import CubicSpline, RegularGridInterpolator
 
 from bridge.errors import InputError
-from bridge.flutter.derivatives import FRF, VERTICAL_TORSIONAL, FlutterDerivatives, frf_from_derivatives
+from bridge.flutter.conventions import ARGUMENTS, FRF_OF, SCANLAN, TERMS, Convention, to_reduced_frequency
+from bridge.flutter.derivatives import (
+    DERIVATIVE_NAMES,
+    FRF,
+    FRF_NAMES,
+    LATERAL,
+    VERTICAL_TORSIONAL,
+    FlutterDerivatives,
+    frf_from_derivatives,
+)
 
-__all__ = ["FRFTable", "DerivativeTable", "check_within"]
+__all__ = ["FRFTable", "DerivativeTable", "check_within", "MISSING_DERIVATIVES", "DERIVATIVE_PAIRS"]
 
-FRF_NAMES = VERTICAL_TORSIONAL  # the four h_xy a table carries today
+MISSING_DERIVATIVES = ("error", "zero")
+# FRF -> (the derivative of its real part, of its imaginary part), e.g. h_pu = c K^2 (H4 + i H1)
+DERIVATIVE_PAIRS: dict[str, tuple[str, str]] = {
+    FRF_OF[load, motion]: tuple(sorted((n for n, t in TERMS.items() if t[:2] == (load, motion)),
+                                       key=lambda n: TERMS[n][2] != "real"))
+    for load, motion in FRF_OF}
 
 
 _RANGE_RTOL = 1e-12  # round-off allowance at the ends of a table (never more)
@@ -42,13 +58,15 @@ class FRFTable:
     HDF5 schema read by :meth:`from_hdf5` (documented in docs/results.md, "Aerodynamic table (input)"):
     in group ``group`` (default ``/``): ``reduced_frequency`` (n_Omega,) float64 Omega = w B / V,
     ``speed_m_s`` (n_V,) float64, and ``h_pu``, ``h_ptheta``, ``h_mu``, ``h_mtheta`` (n_Omega, n_V)
-    complex128, thesis sign conventions; at least 2 points on each axis.
+    complex128, thesis sign conventions; at least 2 points on each axis.  Optional: any of the lateral
+    ``h_pr``, ``h_qu``, ``h_qr``, ``h_qtheta``, ``h_mr`` (same shape, conventions of
+    :mod:`bridge.flutter.derivatives`); those present are in ``provides``, the others are zero.
     """
 
     name = "table"
-    provides = FRF_NAMES
 
-    def __init__(self, omega: np.ndarray, speed: np.ndarray, values: FRF, source: str = "table"):
+    def __init__(self, omega: np.ndarray, speed: np.ndarray, values: FRF, source: str = "table",
+                 provides: tuple[str, ...] = VERTICAL_TORSIONAL):
         omega = np.asarray(omega, dtype=np.float64)
         speed = np.asarray(speed, dtype=np.float64)
         for key, axis in (("reduced_frequency", omega), ("speed_m_s", speed)):
@@ -57,12 +75,16 @@ class FRFTable:
                                  "needs >= 2 finite, strictly ascending values")
         if omega[0] < 0.0 or speed[0] <= 0.0:
             raise InputError(f"{source}:axes", (omega[0], speed[0]), "Omega >= 0 and V > 0")
+        self.provides = _provides(provides, source)
         self.omega, self.speed, self.source = omega, speed, source
         self._interp = {}
-        for name in FRF_NAMES:
+        shape = (omega.size, speed.size)
+        for name in self.provides:
             v = np.asarray(getattr(values, name), dtype=np.complex128)
-            if v.shape != (omega.size, speed.size) or not np.all(np.isfinite(v)):
-                raise InputError(f"{source}:{name}", v.shape, f"needs finite shape ({omega.size}, {speed.size})")
+            if v.ndim == 0:                  # a constant (e.g. a lateral term written as 0)
+                v = np.full(shape, v[()])
+            if v.shape != shape or not np.all(np.isfinite(v)):
+                raise InputError(f"{source}:{name}", v.shape, f"needs finite shape {shape} (or one number)")
             self._interp[name] = (
                 RegularGridInterpolator((omega, speed), v.real, bounds_error=True),
                 RegularGridInterpolator((omega, speed), v.imag, bounds_error=True))
@@ -78,12 +100,13 @@ class FRFTable:
             if group not in f:
                 raise InputError("flutter.table_group", group, f"a group in {path}")
             g = f[group]
-            missing = [k for k in ("reduced_frequency", "speed_m_s", *FRF_NAMES) if k not in g]
+            missing = [k for k in ("reduced_frequency", "speed_m_s", *VERTICAL_TORSIONAL) if k not in g]
             if missing:
                 raise InputError(f"{path}:{group}", missing, "datasets required: reduced_frequency, "
-                                 "speed_m_s, h_pu, h_ptheta, h_mu, h_mtheta")
-            values = FRF(*(np.asarray(g[k][()], dtype=np.complex128) for k in FRF_NAMES))
-            return cls(g["reduced_frequency"][()], g["speed_m_s"][()], values, source=str(path))
+                                 "speed_m_s, h_pu, h_ptheta, h_mu, h_mtheta (optional: " + ", ".join(LATERAL) + ")")
+            provides = VERTICAL_TORSIONAL + tuple(n for n in LATERAL if n in g)
+            values = FRF(**{k: np.asarray(g[k][()], dtype=np.complex128) for k in provides})
+            return cls(g["reduced_frequency"][()], g["speed_m_s"][()], values, source=str(path), provides=provides)
 
     @property
     def omega_range(self) -> tuple[float, float]:
@@ -99,8 +122,16 @@ class FRFTable:
         check_within("flutter.speed_m_s", speed, *self.speed_range, f"the table {self.source}")
         pts = np.stack([np.clip(omega, *self.omega_range), np.clip(speed, *self.speed_range)], axis=-1)
         pts = pts.reshape(-1, 2)
-        return FRF(*((re(pts) + 1j * im(pts)).reshape(omega.shape)
-                     for re, im in (self._interp[n] for n in FRF_NAMES)))
+        return FRF(**{n: (re(pts) + 1j * im(pts)).reshape(omega.shape) for n, (re, im) in self._interp.items()})
+
+
+def _provides(provides, source: str) -> tuple[str, ...]:
+    """Checked ``provides``: known FRF names, the vertical-torsional four always among them, FRF order."""
+    provides = tuple(provides)
+    unknown = [n for n in provides if n not in FRF_NAMES]
+    if unknown:
+        raise InputError(f"{source}:provides", unknown, f"FRF names: {', '.join(FRF_NAMES)}")
+    return tuple(n for n in FRF_NAMES if n in provides or n in VERTICAL_TORSIONAL)
 
 
 def _linear(x_table: np.ndarray, y_table: np.ndarray):
@@ -111,54 +142,125 @@ def _linear(x_table: np.ndarray, y_table: np.ndarray):
 
 
 class DerivativeTable:
-    """Scanlan's flutter derivatives against K (or reduced velocity U/(fB) = 2 pi / K) from a CSV file.
+    """Flutter derivatives against a reduced frequency or velocity (V-independent), e.g. from a wind tunnel.
 
-    CSV: one header row, ``#`` comment lines allowed; a column ``K`` (= B w / U) or ``reduced_velocity``
-    (= U / (f B)), and columns ``H1 H2 H3 H4 A1 A2 A3 A4`` (a trailing ``*`` in a name is accepted);
-    Scanlan's convention (h, L positive down; alpha, M nose-up; mid-chord).  The table is converted to
-    h_xy = K^2 (...) (smooth in K, whereas H* ~ 1/K^2) and interpolated in K with a cubic spline (linear
-    with fewer than 4 rows).  Independent of V.  Outside the table's K range: InputError.
+    Held in the Scanlan form of :mod:`bridge.flutter.derivatives` (``derivatives``, against K = B w / U),
+    converted to h_xy = c K^2 (...) (smooth in K, whereas H* ~ 1/K^2) and interpolated in K with a cubic
+    spline (linear with fewer than 4 rows).  ``provides``: the FRFs the table determines (the
+    vertical-torsional four always; a lateral one when the table has one of its two derivatives); the
+    others are zero, for :class:`bridge.flutter.aerodynamics.WithLateral` to fill.  ``convention``: the
+    convention the table was given in (None when built from Scanlan-form arrays).  Outside the table's K
+    range: InputError.
+
+    CSV (:meth:`from_csv`): ``#`` comment lines, of which ``# convention: ...`` state the convention
+    (:mod:`bridge.flutter.conventions`); one header row; exactly one argument column, ``K`` (= B w/U),
+    ``k`` (= b w/U, b = B/2), ``reduced_velocity`` (= U/(fB)) or ``reduced_velocity_omega`` (= U/(wB));
+    derivative columns among H1-H6, A1-A6, P1-P6 (a trailing ``*`` accepted).  Every column is read;
+    other columns are ignored with a warning naming them.  H1-H4 and A1-A4 are required, and a lateral
+    FRF given by one of its two derivatives needs the other (H5/H6, A5/A6, P1/P4, P2/P3, P5/P6), unless
+    ``missing = "zero"`` says the missing ones are zero.  A lateral FRF with neither column is not
+    provided (not "zero": another model may fill it); to state that it is zero, give its columns as 0.
     """
 
     name = "derivatives"
-    provides = FRF_NAMES
 
-    def __init__(self, K: np.ndarray, derivatives: FlutterDerivatives, source: str = "derivatives"):
+    def __init__(self, K: np.ndarray, derivatives: FlutterDerivatives, source: str = "derivatives",
+                 provides: tuple[str, ...] = VERTICAL_TORSIONAL, convention: Convention | None = None):
         K = np.asarray(K, dtype=np.float64)
+        if K.ndim != 1 or K.size < 2 or not np.all(np.isfinite(K)) or np.any(K <= 0.0):
+            raise InputError(f"{source}:K", K.tolist()[:8], "needs >= 2 finite K > 0")
         order = np.argsort(K)
         K = K[order]
-        if K.size < 2 or K[0] <= 0.0 or np.any(np.diff(K) <= 0) or not np.all(np.isfinite(K)):
+        if np.any(np.diff(K) <= 0):
             raise InputError(f"{source}:K", K.tolist()[:8], "needs >= 2 distinct finite K > 0")
         d = FlutterDerivatives(*(np.broadcast_to(np.asarray(v, dtype=np.float64), K.shape)[order]
                                  for v in derivatives))
+        self.provides = _provides(provides, source)
+        stray = [n for f in FRF_NAMES if f not in self.provides for n in DERIVATIVE_PAIRS[f]
+                 if np.any(getattr(d, n) != 0.0)]
+        if stray:
+            raise InputError(f"{source}:provides", self.provides,
+                             f"derivatives {', '.join(stray)} are not zero: name their FRFs in provides")
+        if not all(np.all(np.isfinite(v)) for v in d):
+            raise InputError(source, "non-finite derivative", "finite numbers in every cell")
         h = frf_from_derivatives(K, d)
-        self.K, self.derivatives, self.source = K, d, source
-        if K.size >= 4:
-            self._spline = {n: CubicSpline(K, getattr(h, n)) for n in FRF_NAMES}
-        else:
-            self._spline = {n: _linear(K, getattr(h, n)) for n in FRF_NAMES}
+        self.K, self.derivatives, self.source, self.convention = K, d, source, convention
+        interp = CubicSpline if K.size >= 4 else _linear
+        self._spline = {n: interp(K, getattr(h, n)) for n in self.provides}
 
     @classmethod
-    def from_csv(cls, path: str | Path) -> DerivativeTable:
+    def from_csv(cls, path: str | Path, convention: Convention | None = None,
+                 missing: str = "error") -> DerivativeTable:
+        """Read a CSV table (class docstring).  ``convention``: keys stated in the scenario
+        ([flutter.derivatives_convention]); merged with the file's ``# convention:`` lines, a key stated
+        differently by the two is an InputError.  ``missing``: "error" | "zero" (missing derivatives)."""
+        if missing not in MISSING_DERIVATIVES:
+            raise InputError("flutter.missing_derivatives", missing, f"one of {', '.join(MISSING_DERIVATIVES)}")
         path = Path(path)
         if not path.is_file():
             raise InputError("flutter.derivatives_path", str(path), "an existing CSV file")
-        with path.open(newline="") as fh:
-            rows = [r for r in csv.reader(fh) if r and not r[0].lstrip().startswith("#")]
+        source = str(path)
+        stated = Convention()
+        data_lines = []
+        for line in path.read_text().splitlines():
+            text = line.strip()
+            if text.startswith("#"):
+                body = text.lstrip("#").strip()
+                if body.lower().startswith("convention:"):
+                    stated = stated.merged(Convention.parse(body.split(":", 1)[1], f"{source}: convention"),
+                                           "an earlier convention line", "a later one")
+            elif text:
+                data_lines.append(line)
+        rows = [r for r in csv.reader(data_lines) if any(c.strip() for c in r)]
         if len(rows) < 3:
-            raise InputError(str(path), len(rows), "a header row and at least 2 data rows")
+            raise InputError(source, len(rows), "a header row and at least 2 data rows")
         header = [c.strip().rstrip("*").strip() for c in rows[0]]
-        names = ("H1", "H2", "H3", "H4", "A1", "A2", "A3", "A4")
-        missing = [n for n in names if n not in header]
-        if missing or not ({"K", "reduced_velocity"} & set(header)):
-            raise InputError(f"{path}:header", rows[0], "columns K or reduced_velocity, and " + " ".join(names))
+        seen = [h for i, h in enumerate(header) if h in header[:i]]
+        if seen:
+            raise InputError(f"{source}:header", seen, "each column once")
+        arguments = [h for h in header if h in ARGUMENTS]
+        if len(arguments) != 1:
+            raise InputError(f"{source}:header", rows[0],
+                             f"exactly one argument column, one of {', '.join(ARGUMENTS)} "
+                             "(K = B w/U, k = b w/U with b = B/2, U/(fB), U/(wB))")
+        given = [h for h in header if h in DERIVATIVE_NAMES]
+        unknown = [h for h in header if h not in ARGUMENTS and h not in DERIVATIVE_NAMES]
+        if unknown:
+            warnings.warn(f"{source}: columns ignored (neither an argument nor a flutter derivative): "
+                          f"{', '.join(unknown)}", UserWarning, stacklevel=2)
+        # the derivatives a table must have: H1-H4, A1-A4, and the partner of each lateral one it has
+        needed = [n for f in FRF_NAMES for n in DERIVATIVE_PAIRS[f]
+                  if f in VERTICAL_TORSIONAL or any(m in given for m in DERIVATIVE_PAIRS[f])]
+        absent = [n for n in needed if n not in given]
+        if absent and missing == "error":
+            raise InputError(f"{source}:header", ", ".join(absent),
+                             "these derivative columns are missing; add them, or set [flutter] "
+                             "missing_derivatives = \"zero\" to take them as zero")
+        if convention is not None:
+            stated = stated.merged(convention, f"{source}", "[flutter.derivatives_convention]")
+        if not stated.stated:
+            raise InputError(f"{source}: convention", "none stated",
+                             "a derivative table must state its convention; " + _HOW_TO)
+        stated.require(given, source)
+        width = len(header)
+        uneven = [i + 2 for i, r in enumerate(rows[1:]) if len(r) != width]
+        if uneven:
+            raise InputError(source, f"data rows {uneven[:5]}", f"{width} cells in every row, as in the header")
         try:
             data = np.array([[float(c) for c in r] for r in rows[1:]], dtype=np.float64)
         except ValueError as exc:
-            raise InputError(str(path), str(exc), "numbers in every data cell") from None
-        col = {n: data[:, header.index(n)] for n in header if n in names or n in ("K", "reduced_velocity")}
-        K = col["K"] if "K" in col else 2.0 * np.pi / col["reduced_velocity"]
-        return cls(K, FlutterDerivatives(*(col[n] for n in names)), source=str(path))
+            raise InputError(source, str(exc), "numbers in every data cell") from None
+        if not np.all(np.isfinite(data)):
+            raise InputError(source, "nan or inf", "finite numbers in every data cell")
+        col = {h: data[:, i] for i, h in enumerate(header)}
+        x = col[arguments[0]]
+        if np.any(x <= 0.0):
+            raise InputError(f"{source}:{arguments[0]}", float(x.min()), "> 0")
+        K = to_reduced_frequency(arguments[0], x)
+        scanlan = stated.converted({n: col[n] for n in given}, SCANLAN)
+        provides = VERTICAL_TORSIONAL + tuple(f for f in LATERAL if any(n in given for n in DERIVATIVE_PAIRS[f]))
+        d = FlutterDerivatives(**{n: scanlan.get(n, np.zeros_like(K)) for n in DERIVATIVE_NAMES})
+        return cls(K, d, source=source, provides=provides, convention=stated)
 
     @property
     def omega_range(self) -> tuple[float, float]:
@@ -172,4 +274,11 @@ class DerivativeTable:
         omega, _ = np.broadcast_arrays(np.asarray(omega, dtype=np.float64), np.asarray(speed, dtype=np.float64))
         check_within("flutter.reduced_frequency", omega, *self.omega_range, f"the derivative table {self.source}")
         x = np.clip(omega, *self.omega_range)
-        return FRF(*(np.asarray(self._spline[n](x), dtype=np.complex128) for n in FRF_NAMES))
+        return FRF(**{n: np.asarray(s(x), dtype=np.complex128) for n, s in self._spline.items()})
+
+
+_HOW_TO = ("add a comment line such as '# convention: vertical=down lift=down lateral=downwind drag=downwind "
+           "pitch=nose_up reference_length=B' with the directions and reference length of YOUR source "
+           "(vertical, lift: up|down; lateral, drag: downwind|upwind; pitch, moment: nose_up|nose_down; "
+           "reference_length: B|b), or the same keys in a [flutter.derivatives_convention] table; see "
+           "docs/flutter.md, 'Derivative tables: conventions'")

@@ -130,11 +130,12 @@ def test_derivative_csv_header_and_cells_are_checked(tmp_path):
     from bridge.flutter.aerodynamics import DerivativeTable
 
     good = tmp_path / "d.csv"
-    good.write_text("K,H1,H2,H3,H4,A1,A2,A3,A4\n0.5,1,2,3,4,5,6,7,8\n1.0,1,2,3,4,5,6,7,8\n")
+    convention = "# convention: vertical=down lift=down pitch=nose_up reference_length=B\n"
+    good.write_text(convention + "K,H1,H2,H3,H4,A1,A2,A3,A4\n0.5,1,2,3,4,5,6,7,8\n1.0,1,2,3,4,5,6,7,8\n")
     assert DerivativeTable.from_csv(good).omega_range == (0.5, 1.0)
     for text in ("K,H1,H2\n0.5,1,2\n1.0,1,2\n", "K,H1,H2,H3,H4,A1,A2,A3,A4\n0.5,1,2,3,4,5,6,7,x\n1,1,2,3,4,5,6,7,8\n"):
         bad = tmp_path / "bad.csv"
-        bad.write_text(text)
+        bad.write_text(convention + text)
         with pytest.raises(InputError):
             DerivativeTable.from_csv(bad)
     with pytest.raises(InputError, match="derivatives_path"):
