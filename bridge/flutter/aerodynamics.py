@@ -12,7 +12,8 @@ the thesis's (u, p positive up; theta, m nose-up; moment about mid-chord), see
 * :class:`WithLateral` - any of the others completed by the quasi-steady lateral terms.
 * :class:`FRFTable` - h_xy tabulated over (Omega, V) in HDF5 (written by the CFD stage), linear
   interpolation of real and imaginary parts; asking outside the table raises InputError.
-* :class:`DerivativeTable` - Scanlan's H1*..A4* against reduced velocity or K from a CSV file; assumed
+* :class:`DerivativeTable` - any of the 18 flutter derivatives against reduced velocity or K from a CSV
+  file in the convention it states (:mod:`bridge.flutter.conventions`); assumed
   independent of V (Reynolds number), interpolated in K; outside the table's K raises InputError.
 """
 

@@ -241,6 +241,13 @@ def _write_h5(group: Any, d: FlutterStageResult) -> None:
     _text(p, "torsion", [r.pair[1] for r in d.pairs], f"({n_p},) torsional mode of each pair")
     write_dataset(p, "flutter", np.array([r.flutter for r in d.pairs], dtype=np.int8), "",
                   f"({n_p},) flag: 1 if the pair flutters below its maximum speed searched, else 0")
+    write_dataset(p, "no_root_in_covered_range", np.array([r.no_root_in_covered_range for r in d.pairs],
+                                                          dtype=np.int8), "",
+                  f"({n_p},) flag: 1 if no root was found but the aerodynamic table did not cover the whole "
+                  "search (not 'no flutter'), else 0")
+    write_dataset(p, "covered_omega_range", np.array([r.covered_omega_range for r in d.pairs]), "1",
+                  f"({n_p}, 2) [pair, (low, high)] reduced frequencies Omega = w B / V the aerodynamic model "
+                  "covers (0, inf for a closed form)")
     for name, unit, what in (
             ("critical_speed_m_s", "m/s", "critical wind speed V_c (NaN if none)"),
             ("frequency_hz", "Hz", "flutter frequency f_c (NaN if none)"),
