@@ -19,6 +19,7 @@ if __name__ == "__main__":
                                              os._exit(130)))
 
 import argparse
+import contextlib
 import threading
 import time
 import tomllib
@@ -145,8 +146,20 @@ class Interrupts:
 
     def __init__(self):
         self.fired = False
+        self.finished = False
         self._previous = None
         self._hook = None
+
+    def finish(self) -> None:
+        """The interruption is being reported: further Ctrl-C (or one re-delivered late) is ignored, so
+        the exit status stays 130."""
+        self.finished = True
+        with contextlib.suppress(ValueError):
+            signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+    def _redeliver(self) -> None:
+        if not self.finished:
+            os.kill(os.getpid(), signal.SIGINT)
 
     def _handler(self, signum, frame):
         self.fired = True
@@ -157,7 +170,7 @@ class Interrupts:
         prints "Exception ignored in ..." and goes on): deliver it again, to the main flow."""
         if isinstance(info.exc_value, KeyboardInterrupt):
             # from another thread, so that it arrives after this hook has returned, not inside it
-            threading.Timer(0.001, os.kill, (os.getpid(), signal.SIGINT)).start()
+            threading.Timer(0.001, self._redeliver).start()
         else:
             self._hook(info)
 
@@ -171,6 +184,7 @@ class Interrupts:
         return self
 
     def __exit__(self, *exc):
+        self.finished = True
         if self._previous is not None:
             signal.signal(signal.SIGINT, self._previous)
             sys.unraisablehook = self._hook
@@ -193,8 +207,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         except BaseException:
             if not interrupts.fired:
                 raise
+            interrupts.finish()
             kept = f"kept: {', '.join(map(str, written))}" if written else "no result folder written"
-            cache = "" if args.no_cache else f"; finished stages stay in {args.out / '.cache'}"
+            stored = not args.no_cache and any((args.out / ".cache").glob("*/*/output.pkl"))
+            cache = f"; finished stages stay in {args.out / '.cache'}" if stored else ""
             print(f"interrupted; {kept}{cache}", file=sys.stderr)
             return 130
 
@@ -237,4 +253,11 @@ def _run(args: argparse.Namespace, say, written: list[Path]) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    status = main()
+    if status == 130:
+        # interrupted and reported: leave at once, so that no half-finished import or clean-up the
+        # interrupt left behind can turn the exit into a death by SIGINT (seen at ~0.25 s after start)
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(130)
+    sys.exit(status)

@@ -380,10 +380,18 @@ def main(argv: Sequence[str] | None = None) -> int:
         except BaseException:
             if not interrupts.fired:
                 raise
+            interrupts.finish()
             where = f" in {sweep_dir / 'cases'}" if sweep_dir is not None else ""
             print(f"interrupted; finished cases are kept{where} (the same command resumes)", file=sys.stderr)
             return 130
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    status = main()
+    if status == 130:
+        # interrupted and reported: leave at once, so that no half-finished import or clean-up the
+        # interrupt left behind can turn the exit into a death by SIGINT (seen at ~0.25 s after start)
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(130)
+    sys.exit(status)
