@@ -8,19 +8,14 @@ Finished stages are kept in ``OUT/.cache/`` and reused while their inputs are un
 
 from __future__ import annotations
 
-import os
-import signal
 import sys
 
 if __name__ == "__main__":
-    # Ctrl-C while the modules below load (about a second): nothing is written yet, so say so and stop
-    # with 130 instead of printing a traceback; main() installs the handler for the run itself.
-    signal.signal(signal.SIGINT, lambda *_: (print("interrupted; nothing written", file=sys.stderr),
-                                             os._exit(130)))
+    from bridge.interrupts import stop_quietly_while_loading
+
+    stop_quietly_while_loading()
 
 import argparse
-import contextlib
-import threading
 import time
 import tomllib
 from collections.abc import Sequence
@@ -30,11 +25,12 @@ from . import __version__
 from .config import SCENARIO_DIR, load_scenario
 from .errors import ConvergenceError, InputError
 from .files import atomic_write_text, check_output_root
+from .interrupts import Interrupts, exit_command
 from .pipeline import plan_stages, run_scenario
 from .results import check_target, headline
 from .stages import STAGES, RunOptions
 
-__all__ = ["main", "comparison_table", "parse_stages", "EXIT_CODES", "Interrupts"]
+__all__ = ["main", "comparison_table", "parse_stages", "EXIT_CODES"]
 
 # Rows of the side-by-side table: (summary key, label, format).
 COMPARISON_ROWS = [
@@ -136,61 +132,6 @@ def parse_stages(text: str | None) -> list[str] | None:
     return stages
 
 
-class Interrupts:
-    """Ctrl-C as one line and exit status 130, wherever it lands.
-
-    While active, SIGINT sets ``fired`` before raising KeyboardInterrupt, so an exception that the
-    interrupt caused elsewhere (a library turning it into an ImportError half-way through an import,
-    say) is still reported as the interruption it was.
-    """
-
-    def __init__(self):
-        self.fired = False
-        self.finished = False
-        self._previous = None
-        self._hook = None
-
-    def finish(self) -> None:
-        """The interruption is being reported: further Ctrl-C (or one re-delivered late) is ignored, so
-        the exit status stays 130."""
-        self.finished = True
-        with contextlib.suppress(ValueError):
-            signal.signal(signal.SIGINT, signal.SIG_IGN)
-
-    def _redeliver(self) -> None:
-        if not self.finished:
-            os.kill(os.getpid(), signal.SIGINT)
-
-    def _handler(self, signum, frame):
-        self.fired = True
-        raise KeyboardInterrupt
-
-    def _unraisable(self, info) -> None:
-        """An interrupt that landed in a destructor or weakref callback is swallowed there (Python
-        prints "Exception ignored in ..." and goes on): deliver it again, to the main flow."""
-        if isinstance(info.exc_value, KeyboardInterrupt):
-            # from another thread, so that it arrives after this hook has returned, not inside it
-            threading.Timer(0.001, self._redeliver).start()
-        else:
-            self._hook(info)
-
-    def __enter__(self):
-        try:
-            self._previous = signal.signal(signal.SIGINT, self._handler)
-        except ValueError:  # not the main thread (e.g. called from a worker): leave SIGINT alone
-            self._previous = None
-            return self
-        self._hook, sys.unraisablehook = sys.unraisablehook, self._unraisable
-        return self
-
-    def __exit__(self, *exc):
-        self.finished = True
-        if self._previous is not None:
-            signal.signal(signal.SIGINT, self._previous)
-            sys.unraisablehook = self._hook
-        return False
-
-
 def main(argv: Sequence[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     say = (lambda m: None) if args.quiet else (lambda m: print(m, file=sys.stderr, flush=True))
@@ -253,11 +194,4 @@ def _run(args: argparse.Namespace, say, written: list[Path]) -> int:
 
 
 if __name__ == "__main__":
-    status = main()
-    if status == 130:
-        # interrupted and reported: leave at once, so that no half-finished import or clean-up the
-        # interrupt left behind can turn the exit into a death by SIGINT (seen at ~0.25 s after start)
-        sys.stdout.flush()
-        sys.stderr.flush()
-        os._exit(130)
-    sys.exit(status)
+    exit_command(main())

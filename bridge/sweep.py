@@ -16,21 +16,19 @@ plus the varied inputs), ``OUT/<sweep>/sweep.csv`` the same table for a spreadsh
 
 from __future__ import annotations
 
-import os
-import signal
 import sys
 
 if __name__ == "__main__":
-    # Ctrl-C while the modules below load (about a second): nothing is written yet, so say so and stop
-    # with 130 instead of printing a traceback; main() installs the handler for the run itself.
-    signal.signal(signal.SIGINT, lambda *_: (print("interrupted; nothing written", file=sys.stderr),
-                                             os._exit(130)))
+    from bridge.interrupts import stop_quietly_while_loading
+
+    stop_quietly_while_loading()
 
 import argparse
 import contextlib
 import itertools
 import json
 import math
+import os
 import re
 import signal
 import tempfile
@@ -45,6 +43,7 @@ import numpy as np
 
 from .config import load_scenario
 from .errors import ConvergenceError, InputError
+from .interrupts import Interrupts, exit_command
 
 __all__ = ["Case", "plan_cases", "run_case", "run_sweep", "collect", "main"]
 
@@ -328,7 +327,7 @@ def _parser() -> argparse.ArgumentParser:
 def main(argv: Sequence[str] | None = None) -> int:
     from .files import check_output_root
     from .pipeline import plan_stages
-    from .scenario import Interrupts, parse_stages
+    from .scenario import parse_stages
 
     args = _parser().parse_args(argv)
     say = lambda m: print(m, file=sys.stderr, flush=True)  # noqa: E731
@@ -387,11 +386,4 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    status = main()
-    if status == 130:
-        # interrupted and reported: leave at once, so that no half-finished import or clean-up the
-        # interrupt left behind can turn the exit into a death by SIGINT (seen at ~0.25 s after start)
-        sys.stdout.flush()
-        sys.stderr.flush()
-        os._exit(130)
-    sys.exit(status)
+    exit_command(main())

@@ -73,38 +73,38 @@ class ModeSet:
     deck_length_m: float
     mid_span_z_m: float
 
+    def integral(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """(1/L) int a_i b_j dz over the deck (trapezoidal rule on the girder nodes), for deck fields
+        a, b of shape (n, n_z): the modal integrals of Eq 4.34."""
+        w = trapezoid_weights(self.z_m) / self.deck_length_m
+        return (a * w) @ b.T
+
     @property
     def uu(self) -> np.ndarray:
-        w = trapezoid_weights(self.z_m) / self.deck_length_m
-        return (self.U * w) @ self.U.T
+        return self.integral(self.U, self.U)
 
     @property
     def ut(self) -> np.ndarray:
-        w = trapezoid_weights(self.z_m) / self.deck_length_m
-        return (self.U * w) @ self.Theta.T
+        return self.integral(self.U, self.Theta)
 
     @property
     def tt(self) -> np.ndarray:
-        w = trapezoid_weights(self.z_m) / self.deck_length_m
-        return (self.Theta * w) @ self.Theta.T
+        return self.integral(self.Theta, self.Theta)
 
     @property
     def vv(self) -> np.ndarray:
         """(1/L) int V_i V_j dz: lateral deck displacement (u_x) of mode i against mode j."""
-        w = trapezoid_weights(self.z_m) / self.deck_length_m
-        return (self.V * w) @ self.V.T
+        return self.integral(self.V, self.V)
 
     @property
     def uv(self) -> np.ndarray:
         """(1/L) int U_i V_j dz."""
-        w = trapezoid_weights(self.z_m) / self.deck_length_m
-        return (self.U * w) @ self.V.T
+        return self.integral(self.U, self.V)
 
     @property
     def vt(self) -> np.ndarray:
         """(1/L) int V_i Theta_j dz."""
-        w = trapezoid_weights(self.z_m) / self.deck_length_m
-        return (self.V * w) @ self.Theta.T
+        return self.integral(self.V, self.Theta)
 
     def index(self, label: str) -> int:
         return self.labels.index(label)

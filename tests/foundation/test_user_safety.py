@@ -415,7 +415,7 @@ def test_readme_commands_and_option_names_match_the_code():
 def test_an_interrupt_swallowed_by_a_destructor_is_delivered_again(capfd):
     """Ctrl-C can land inside a destructor or weakref callback, where Python prints "Exception ignored"
     and carries on (seen once in a sweep): the command must still stop, and print nothing of it."""
-    from bridge.scenario import Interrupts
+    from bridge.interrupts import Interrupts
 
     class Interrupted:
         def __del__(self):

@@ -1,0 +1,95 @@
+"""Ctrl-C on the command line: one line and exit status 130, wherever it lands.
+
+Three moments need care:
+
+* while the modules load (the first second after ``python -m bridge.scenario``): nothing has been written,
+  so :func:`stop_quietly_while_loading` says so and leaves;
+* during the run: :class:`Interrupts` marks the interruption, so that whatever exception it turns into
+  (a KeyboardInterrupt, or an ImportError raised half-way through an import) is reported as what it was;
+  an interrupt that Python swallows in a destructor or weakref callback ("Exception ignored in ...") is
+  delivered again to the main flow;
+* at the exit: :func:`exit_command` leaves at once with 130 after the report, so that nothing the
+  interrupt left half-done (an import, a clean-up) can turn the exit into a death by SIGINT (seen about
+  0.25 s after start, exit status -2).
+Only the standard library is imported here: this module loads before everything else.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import signal
+import sys
+import threading
+
+__all__ = ["Interrupts", "stop_quietly_while_loading", "exit_command", "INTERRUPTED"]
+
+INTERRUPTED = 130  # the shell's convention: 128 + SIGINT
+
+
+def stop_quietly_while_loading() -> None:
+    """Until the command installs :class:`Interrupts`: Ctrl-C prints one line and exits with 130."""
+    signal.signal(signal.SIGINT, lambda *_: (print("interrupted; nothing written", file=sys.stderr),
+                                             os._exit(INTERRUPTED)))
+
+
+def exit_command(status: int) -> None:
+    """End the process with ``status``; after an interruption, at once (see the module docstring)."""
+    if status == INTERRUPTED:
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(INTERRUPTED)
+    sys.exit(status)
+
+
+class Interrupts:
+    """While active, SIGINT sets ``fired`` before raising KeyboardInterrupt, so an exception that the
+    interrupt caused elsewhere (a library turning it into an ImportError half-way through an import,
+    say) is still reported as the interruption it was.
+    """
+
+    def __init__(self):
+        self.fired = False
+        self.finished = False
+        self._previous = None
+        self._hook = None
+
+    def finish(self) -> None:
+        """The interruption is being reported: further Ctrl-C (or one re-delivered late) is ignored, so
+        the exit status stays 130."""
+        self.finished = True
+        with contextlib.suppress(ValueError):
+            signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+    def _redeliver(self) -> None:
+        if not self.finished:
+            os.kill(os.getpid(), signal.SIGINT)
+
+    def _handler(self, signum, frame):
+        self.fired = True
+        raise KeyboardInterrupt
+
+    def _unraisable(self, info) -> None:
+        """An interrupt that landed in a destructor or weakref callback is swallowed there (Python
+        prints "Exception ignored in ..." and goes on): deliver it again, to the main flow."""
+        if isinstance(info.exc_value, KeyboardInterrupt):
+            # from another thread, so that it arrives after this hook has returned, not inside it
+            threading.Timer(0.001, self._redeliver).start()
+        else:
+            self._hook(info)
+
+    def __enter__(self):
+        try:
+            self._previous = signal.signal(signal.SIGINT, self._handler)
+        except ValueError:  # not the main thread (e.g. called from a worker): leave SIGINT alone
+            self._previous = None
+            return self
+        self._hook, sys.unraisablehook = sys.unraisablehook, self._unraisable
+        return self
+
+    def __exit__(self, *exc):
+        self.finished = True
+        if self._previous is not None:
+            signal.signal(signal.SIGINT, self._previous)
+            sys.unraisablehook = self._hook
+        return False
