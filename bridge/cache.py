@@ -9,7 +9,7 @@ Each stage's output is stored under a key, the SHA-256 of everything the result 
   the stage declares it ``ignores`` and, for a ``shared`` stage, the scenario's name), and the bytes
   of every input file the scenario names (``*_path`` keys, e.g. a measured aerodynamic table);
 * the keys of the upstream stages it reads (a key fixes its output: same inputs, same code);
-* the run options that change results (``quick``).
+* the run options that change results (``quick``, ``quality``).
 
 A stored entry is a folder ``<cache>/<stage>/<key>/`` with ``output.pkl`` (summary, report, the stage's
 HDF5 group as a file image, its figures as PNG bytes, and the Python result object that later stages
@@ -69,13 +69,15 @@ def _file_digest(path: Path) -> str:
     return h.hexdigest()
 
 
-def stage_key(name: str, scenario: Any, upstream_keys: Mapping[str, str], quick: bool) -> str:
+def stage_key(name: str, scenario: Any, upstream_keys: Mapping[str, str], quick: bool,
+              quality: str | None = None) -> str:
     """The cache key of stage ``name`` for this scenario (see the module docstring)."""
     from .config import scenario_fields
 
     stage = STAGES[name]
     skip = set(IDENTITY_FIELDS) | set(stage.ignores) | ({"name"} if stage.shared else set())
-    inputs = {k: v for k, v in scenario_fields(scenario).items() if k.split(".")[0].split("[")[0] not in skip}
+    inputs = {k: v for k, v in scenario_fields(scenario).items()
+              if (top := k.split(".")[0].split("[")[0]) not in skip and (stage.uses is None or top in stage.uses)}
     files = {}
     base = Path(scenario.source_path).parent if getattr(scenario, "source_path", None) else Path.cwd()
     for k, v in inputs.items():
@@ -84,7 +86,8 @@ def stage_key(name: str, scenario: Any, upstream_keys: Mapping[str, str], quick:
             files[k] = _file_digest(p) if p.is_file() else "missing"
     blob = json.dumps({"format": CACHE_FORMAT, "stage": name, "version": __version__,
                        "code": _code_digest(COMMON_CODE + stage.code), "inputs": inputs, "files": files,
-                       "upstream": {k: upstream_keys[k] for k in sorted(upstream_keys)}, "quick": bool(quick)},
+                       "upstream": {k: upstream_keys[k] for k in sorted(upstream_keys)}, "quick": bool(quick),
+                       **({"quality": quality} if quality is not None else {})},
                       sort_keys=True, default=repr)
     return hashlib.sha256(blob.encode()).hexdigest()
 

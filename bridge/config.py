@@ -300,6 +300,8 @@ class Scenario:
     flutter: Any = None   # bridge.flutter.options.FlutterOptions
     section: Any = None   # bridge.flutter.section.SectionModel (kind == "section")
     modal: Any = None     # bridge.flutter.modal.ModalModel given directly
+    deck_section: Any = None  # bridge.cfd.sections section (the [deck_section] table), for the aero stage
+    aero: Any = None          # bridge.aero.options.AeroOptions (the [aero] table)
 
     # Eq 4.7 ------------------------------------------------------------------------------------------
     @property
@@ -430,7 +432,8 @@ def _parse_bridge(t: _Table, name: str, description: str, source: str | None) ->
 
 
 def _parse_optional_tables(t: _Table, scenario: Scenario) -> Scenario:
-    """[flutter], [section] and [modal] tables belong to the flutter package, which validates them."""
+    """[flutter], [section] and [modal] tables belong to the flutter package, [deck_section] to
+    bridge.cfd.sections and [aero] to bridge.aero; each validates its own."""
     updates: dict[str, Any] = {}
     if "flutter" in t.data:
         from .flutter.options import FlutterOptions
@@ -444,6 +447,14 @@ def _parse_optional_tables(t: _Table, scenario: Scenario) -> Scenario:
         from .flutter.modal import ModalModel
 
         updates["modal"] = ModalModel.from_mapping(t.raw("modal"), "modal")
+    if "deck_section" in t.data:
+        from .cfd.sections import section_from_mapping
+
+        updates["deck_section"] = section_from_mapping(t.raw("deck_section"), "deck_section")
+    if "aero" in t.data:
+        from .aero.options import AeroOptions
+
+        updates["aero"] = AeroOptions.from_mapping(t.raw("aero"), "aero")
     return replace(scenario, **updates) if updates else scenario
 
 

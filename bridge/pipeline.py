@@ -20,12 +20,20 @@ from .stages import STAGES, RunOptions, StageOutput, resolve_stage
 __all__ = ["plan_stages", "run_stages", "run_scenario", "default_stages"]
 
 # Stages that only make sense for one kind of scenario.
-_KIND_STAGES = {"suspension_bridge": ("cable", "fem", "flutter"), "section": ("flutter",), "modal": ("flutter",)}
+_KIND_STAGES = {"suspension_bridge": ("cable", "fem", "aero", "flutter"), "section": ("aero", "flutter"),
+                "modal": ("aero", "flutter")}
+
+
+def wants_cfd(scenario: Scenario) -> bool:
+    """True when the flutter stage is to use the deck's own aerodynamics (``[flutter] aerodynamics = "cfd"``)."""
+    fl, section = getattr(scenario, "flutter", None), getattr(scenario, "section", None)
+    return "cfd" in (getattr(fl, "aerodynamics", None), getattr(section, "aerodynamics", None))
 
 
 def default_stages(scenario: Scenario) -> tuple[str, ...]:
-    """The registered stages a scenario of this kind runs when none are named."""
-    return tuple(s for s in _KIND_STAGES.get(scenario.kind, ()) if s in STAGES)
+    """The registered stages a scenario of this kind runs when none are named (the aero stage only when
+    the flutter stage is to use it)."""
+    return tuple(s for s in _KIND_STAGES.get(scenario.kind, ()) if s in STAGES and (s != "aero" or wants_cfd(scenario)))
 
 
 def plan_stages(scenario: Scenario, requested: Iterable[str] | None) -> tuple[str, ...]:
@@ -45,6 +53,8 @@ def plan_stages(scenario: Scenario, requested: Iterable[str] | None) -> tuple[st
         for dep in STAGES[name].needs:
             if scenario.kind in ("section", "modal") and dep in ("cable", "fem"):
                 continue  # a sectional model or given modes carry their own modal data
+            if dep == "aero" and not wants_cfd(scenario):
+                continue  # the flutter stage reads the CFD only when asked to
             need(dep)
 
     for name in wanted:
@@ -73,7 +83,7 @@ def run_stages(scenario: Scenario, stages: Iterable[str] | None = None,
             outputs[name] = resolve_stage(name)(scenario, outputs, options)
             continue
         keys[name] = cache.stage_key(name, scenario, {d: keys[d] for d in STAGES[name].needs if d in keys},
-                                     options.quick)
+                                     options.quick, options.quality if name == "aero" else None)
         hit = cache.load(options.cache, name, keys[name])
         if hit is not None:
             options.say(f"[{scenario.name}] {name}: inputs unchanged, reusing the stored result "

@@ -117,6 +117,9 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--no-cache", action="store_true",
                    help="compute every stage afresh (and do not store them in OUT/.cache/)")
     p.add_argument("--quick", action="store_true", help="coarse meshes/grids: a fast smoke run")
+    p.add_argument("--quality", choices=("tiny", "quick", "standard", "fine"), default=None,
+                   help="CFD preset of the aero stage (grid, time step, Reynolds number; docs/aero.md); "
+                        "default: the scenario's [aero] quality, tiny with --quick")
     p.add_argument("--quiet", action="store_true", help="no progress messages")
     p.add_argument("--version", action="version", version=f"bridge-flutter {__version__}")
     return p
@@ -174,7 +177,8 @@ def _run(args: argparse.Namespace, say, written: list[Path]) -> int:
     if len(scenarios) > 1 and comparison.exists() and not args.overwrite:
         raise InputError("--out", str(comparison), "already holds a comparison of an earlier run; pass "
                          "--overwrite to replace it or choose another --out")
-    options = RunOptions(quick=args.quick, progress=say, cache=None if args.no_cache else args.out / ".cache")
+    options = RunOptions(quick=args.quick, progress=say, cache=None if args.no_cache else args.out / ".cache",
+                         quality=args.quality)
     summaries = {}
     for sc in scenarios:
         t0 = time.perf_counter()

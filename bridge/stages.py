@@ -46,11 +46,13 @@ class StageOutput:
 class RunOptions:
     """Options of one run that are not physics: ``quick`` shrinks meshes/grids for tests and smoke runs;
     ``progress`` is a callable taking a one-line message (default: none); ``cache`` is the folder of the
-    stage cache (:mod:`bridge.cache`; None: compute every stage afresh and keep nothing)."""
+    stage cache (:mod:`bridge.cache`; None: compute every stage afresh and keep nothing);
+    ``quality`` the CFD preset of the aero stage (None: the scenario's, "tiny" with ``quick``)."""
 
     quick: bool = False
     progress: Callable[[str], None] | None = None
     cache: Path | None = None
+    quality: str | None = None
 
     def say(self, message: str) -> None:
         if self.progress is not None:
@@ -71,6 +73,8 @@ class Stage:
               with the same inputs share one stored result (a deck section's aerodynamics).  The
               cable, fem and flutter stages put the name in their titles and reference tables, so
               they are not shared.
+    uses    - if set, the only top-level scenario fields the result depends on (the others are left
+              out of the cache key, as with ``ignores``)
     """
 
     target: str
@@ -78,6 +82,7 @@ class Stage:
     code: tuple[str, ...]
     ignores: tuple[str, ...] = ()
     shared: bool = False
+    uses: tuple[str, ...] | None = None
 
 
 # The scenario fields that never change a result: how it is called and where it was read from.
@@ -89,7 +94,11 @@ STAGES: dict[str, Stage] = {
                    ignores=("damping", "air", "flutter", "section", "modal")),
     "fem": Stage("bridge.structure.stage:run", ("cable",), ("bridge.structure", "kernels.fem"),
                  ignores=("air", "flutter", "section", "modal")),
-    "flutter": Stage("bridge.flutter.stage:run", ("fem",), ("bridge.flutter", "bridge.structure.plots")),
+    # the deck's aerodynamics from forced-motion CFD: the section and the [aero] options only, so
+    # bridges with one deck share it (the flutter stage reads it when [flutter] aerodynamics = "cfd")
+    "aero": Stage("bridge.aero.stage:run", (), ("bridge.aero", "bridge.cfd", "kernels.cfd"), shared=True,
+                  uses=("deck_section", "aero")),
+    "flutter": Stage("bridge.flutter.stage:run", ("fem", "aero"), ("bridge.flutter", "bridge.structure.plots")),
 }
 
 

@@ -1,7 +1,8 @@
 """Options of the flutter stage: the ``[flutter]`` table of a scenario file.
 
 Keys (all optional; defaults give a Theodorsen thin-plate analysis up to 150 m/s):
-    aerodynamics      "theodorsen" | "quasi_steady" | "table" | "derivatives"   (default "theodorsen")
+    aerodynamics      "theodorsen" | "quasi_steady" | "table" | "derivatives" | "cfd"   (default "theodorsen";
+                      "cfd": the deck's own, from the aero stage, bridge.aero.stage)
     table_path        HDF5 file of h_xy(Omega, V) (aerodynamics = "table"); relative paths are taken
                       from the scenario file's folder.  Schema: docs/results.md "Aerodynamic table (input)"
     table_group       group inside it (default "/")
@@ -46,7 +47,7 @@ from bridge.flutter.tables import MISSING_DERIVATIVES
 
 __all__ = ["FlutterOptions", "AERODYNAMIC_MODELS"]
 
-AERODYNAMIC_MODELS = ("theodorsen", "quasi_steady", "table", "derivatives")
+AERODYNAMIC_MODELS = ("theodorsen", "quasi_steady", "table", "derivatives", "cfd")
 PAIRS = ("thesis", "all")
 _QS_KEYS = ("lift_coefficient", "lift_slope_per_rad", "drag_coefficient", "moment_coefficient",
             "moment_slope_per_rad")
@@ -149,8 +150,10 @@ class FlutterOptions:
         obj._validate(where)
         return obj
 
-    def aerodynamic_model(self, base_dir: str | Path | None = None) -> AerodynamicModel:
-        """Build (and for tables, read) the aerodynamic model; relative paths are taken from ``base_dir``."""
+    def aerodynamic_model(self, base_dir: str | Path | None = None, cfd: AerodynamicModel | None = None
+                          ) -> AerodynamicModel:
+        """Build (and for tables, read) the aerodynamic model; relative paths are taken from ``base_dir``;
+        ``cfd`` is the aero stage's model (``aerodynamics = "cfd"``)."""
         def resolve(p: str) -> Path:
             q = Path(p)
             return q if q.is_absolute() or base_dir is None else Path(base_dir) / q
@@ -161,6 +164,11 @@ class FlutterOptions:
             base = Theodorsen()
         elif self.aerodynamics == "table":
             base = FRFTable.from_hdf5(resolve(self.table_path), self.table_group)
+        elif self.aerodynamics == "cfd":
+            if cfd is None:
+                raise InputError("flutter.aerodynamics", "cfd", "needs the aero stage's result (run it: it is "
+                                 "planned automatically with the flutter stage)")
+            base = cfd
         elif self.aerodynamics == "derivatives":
             base = DerivativeTable.from_csv(resolve(self.derivatives_path), convention=self.derivatives_convention,
                                             missing=self.missing_derivatives)

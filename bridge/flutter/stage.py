@@ -108,7 +108,8 @@ def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
     if section is not None and section.aerodynamics is not None:
         fopts = replace(fopts, aerodynamics=section.aerodynamics)
     src = getattr(scenario, "source_path", None)
-    aero = fopts.aerodynamic_model(Path(src).parent if src else None)
+    cfd = upstream["aero"].data.model if "aero" in upstream else None
+    aero = fopts.aerodynamic_model(Path(src).parent if src else None, cfd=cfd)
     rho = _air_density(scenario, fopts)
     n_speed = min(fopts.speed_steps, QUICK_SPEED_STEPS) if options.quick else fopts.speed_steps
     kw = dict(min_speed_m_s=fopts.min_speed_m_s, n_speed=n_speed)

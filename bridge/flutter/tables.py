@@ -134,11 +134,15 @@ def _provides(provides, source: str) -> tuple[str, ...]:
     return tuple(n for n in FRF_NAMES if n in provides or n in VERTICAL_TORSIONAL)
 
 
-def _linear(x_table: np.ndarray, y_table: np.ndarray):
-    """Linear interpolation of complex values (used when a table has fewer than 4 rows)."""
-    def f(x):
-        return np.interp(x, x_table, y_table.real) + 1j * np.interp(x, x_table, y_table.imag)
-    return f
+class _Linear:
+    """Linear interpolation of complex values (used when a table has fewer than 4 rows); a class, not a
+    closure, so that a table can be pickled (the stage cache stores it)."""
+
+    def __init__(self, x_table: np.ndarray, y_table: np.ndarray):
+        self.x, self.y = np.asarray(x_table), np.asarray(y_table)
+
+    def __call__(self, x):
+        return np.interp(x, self.x, self.y.real) + 1j * np.interp(x, self.x, self.y.imag)
 
 
 class DerivativeTable:
@@ -185,7 +189,7 @@ class DerivativeTable:
             raise InputError(source, "non-finite derivative", "finite numbers in every cell")
         h = frf_from_derivatives(K, d)
         self.K, self.derivatives, self.source, self.convention = K, d, source, convention
-        interp = CubicSpline if K.size >= 4 else _linear
+        interp = CubicSpline if K.size >= 4 else _Linear
         self._spline = {n: interp(K, getattr(h, n)) for n in self.provides}
 
     @classmethod

@@ -1,0 +1,65 @@
+"""Options of the ``aero`` stage: the ``[aero]`` table of a scenario file.
+
+Keys (all optional):
+    quality               "tiny" | "quick" | "standard" | "fine": grid, time step, Reynolds number and
+                          periods of bridge.aero.forced_motion.QUALITY (default "quick"; --quality on the
+                          command line wins; --quick means "tiny")
+    reduced_velocities    U/(fB) of the forced-motion runs (default 4, 6, 8, 10, 12, 16; at least 2):
+                          the flutter search may use reduced frequencies K = 2 pi / (U/(fB)) only inside
+    heave_rate            heave velocity amplitude over the wind speed, udot_0 / V (default the thesis's
+                          0.4 / 50 = 0.008, thesis 5.3)
+    pitch_rate            rotation-rate amplitude thetadot_0 B / V (default the thesis's 0.028 * 31 / 50)
+    checkpoint_every      steps between checkpoints of a running case (default 2000)
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from bridge.errors import InputError, check_range
+
+__all__ = ["AeroOptions"]
+
+
+@dataclass(frozen=True)
+class AeroOptions:
+    """Validated ``[aero]`` table (module docstring)."""
+
+    quality: str = "quick"
+    reduced_velocities: tuple[float, ...] = (4.0, 6.0, 8.0, 10.0, 12.0, 16.0)
+    heave_rate: float = 0.4 / 50.0
+    pitch_rate: float = 0.028 * 31.0 / 50.0
+    checkpoint_every: int = 2000
+
+    def __post_init__(self):
+        from bridge.aero.forced_motion import QUALITY
+
+        if self.quality not in QUALITY:
+            raise InputError("aero.quality", self.quality, f"one of {', '.join(QUALITY)}")
+        values = self.reduced_velocities
+        if isinstance(values, (str, bytes)) or not isinstance(values, (list, tuple)) or len(values) < 2:
+            raise InputError("aero.reduced_velocities", values, "a list of at least 2 numbers U/(fB)")
+        rv = tuple(sorted(check_range(f"aero.reduced_velocities[{i}]", v, 0.5, 200.0) for i, v in enumerate(values)))
+        if len(set(rv)) != len(rv):
+            raise InputError("aero.reduced_velocities", values, "distinct values")
+        object.__setattr__(self, "reduced_velocities", rv)
+        check_range("aero.heave_rate", self.heave_rate, 0.0, 0.2, low_open=True)
+        check_range("aero.pitch_rate", self.pitch_rate, 0.0, 0.2, low_open=True)
+        if isinstance(self.checkpoint_every, bool) or not isinstance(self.checkpoint_every, int) \
+                or self.checkpoint_every < 10:
+            raise InputError("aero.checkpoint_every", self.checkpoint_every, "an integer >= 10")
+
+    @classmethod
+    def from_mapping(cls, mapping: Mapping[str, Any], where: str = "aero") -> AeroOptions:
+        if not isinstance(mapping, Mapping):
+            raise InputError(where, mapping, "must be a table")
+        allowed = cls.__dataclass_fields__
+        for key in mapping:
+            if key not in allowed:
+                raise InputError(f"{where}.{key}", mapping[key], f"unknown key; allowed: {', '.join(allowed)}")
+        values = dict(mapping)
+        if "reduced_velocities" in values and isinstance(values["reduced_velocities"], list):
+            values["reduced_velocities"] = tuple(values["reduced_velocities"])
+        return cls(**values)

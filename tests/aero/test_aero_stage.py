@@ -1,0 +1,91 @@
+"""The aero stage: forced-motion cases that resume after a kill, and the chain to the flutter stage.
+
+Tiny grids only (seconds): these check the machinery, not the aerodynamics (docs/aero.md has the
+validation against Theodorsen and its status)."""
+
+import numpy as np
+import pytest
+
+from bridge.aero.forced_motion import QUALITY, ForcedCase, run_case
+from bridge.aero.stage import _unit_polygon
+from bridge.cfd.sections import Rectangle
+
+
+class Killed(Exception):
+    pass
+
+
+def test_a_killed_case_resumes_from_its_checkpoint_and_ends_with_the_same_numbers(tmp_path):
+    poly = _unit_polygon(Rectangle(10.0, 2.0))
+    case = ForcedCase("heave", (2.5,), (0.005,))
+    q = QUALITY["tiny"]
+    whole = run_case(poly, case, q)
+    ckpt = tmp_path / "case.h5"
+    calls = []
+
+    def kill_at_half(message):
+        calls.append(message)
+        if len(calls) == 5:
+            raise Killed(message)
+
+    with pytest.raises(Killed):
+        run_case(poly, case, q, checkpoint=ckpt, checkpoint_every=50, progress=kill_at_half)
+    assert ckpt.is_file()
+    notes = []
+    again = run_case(poly, case, q, checkpoint=ckpt, checkpoint_every=50, progress=notes.append)
+    assert again.resumed_from_step > 0 and "resuming" in notes[0]
+    assert again.resumed_from_step < whole.steps        # it did not start from the end either
+    for name in ("t", "lift", "drag", "moment", "motion"):
+        assert np.array_equal(getattr(again, name), getattr(whole, name)), name
+    # a checkpoint of another case is not resumed
+    other = run_case(poly, ForcedCase("heave", (2.5,), (0.01,)), q, checkpoint=ckpt, checkpoint_every=10_000)
+    assert other.resumed_from_step == 0
+
+
+def _section_scenario(path, name_mass):
+    path.write_text(f'''kind = "section"
+[section]
+mass_per_length_kg_m = {name_mass}
+inertia_per_length_kg_m2_m = 4.0e6
+heave_frequency_hz = 0.12
+pitch_frequency_hz = 0.30
+deck_width_m = 30.0
+[deck_section]
+shape = "rectangle"
+chord_m = 30.0
+depth_m = 6.0
+[aero]
+quality = "tiny"
+reduced_velocities = [2.5, 4.0]
+[flutter]
+aerodynamics = "cfd"
+max_speed_m_s = 300.0
+multimode = false
+''')
+    return path
+
+
+@pytest.mark.slow  # ~10 s (four CFD cases): runs in CI with -m slow
+def test_the_aero_stage_feeds_flutter_and_bridges_with_one_deck_share_it(tmp_path):
+    from bridge.config import load_scenario
+    from bridge.pipeline import plan_stages, run_stages
+    from bridge.stages import RunOptions
+
+    a = load_scenario(_section_scenario(tmp_path / "deck_a.toml", 43000.0))
+    b = load_scenario(_section_scenario(tmp_path / "deck_b.toml", 50000.0))
+    assert plan_stages(a, None) == ("aero", "flutter")
+    options = RunOptions(cache=tmp_path / "cache")
+    out_a = run_stages(a, None, options)
+    aero = out_a["aero"].data
+    assert aero.quality == "tiny" and aero.reduced_frequency.tolist() == pytest.approx([np.pi / 2, 2 * np.pi / 2.5])
+    # the flutter stage used exactly the CFD's FRFs (the table reproduces them at the runs' K)
+    h = aero.model.frf(aero.reduced_frequency, 50.0)
+    for name in ("h_pu", "h_ptheta", "h_mu", "h_mtheta"):
+        np.testing.assert_allclose(getattr(h, name), getattr(aero.frf, name), rtol=1e-10, atol=1e-12)
+    assert out_a["flutter"].summary["flutter.aerodynamics"].startswith("cfd (rectangle, tiny")
+    # another bridge (other masses, other name) with the same deck: the aero result is the stored one
+    out_b = run_stages(b, None, options)
+    assert out_b["aero"].from_cache and not out_b["flutter"].from_cache
+    np.testing.assert_array_equal(out_b["aero"].data.frf.h_pu, aero.frf.h_pu)
+    # the cases left their checkpoints, so a re-run after a kill would resume
+    assert len(list((tmp_path / "cache" / "aero-runs").glob("*.h5"))) == 4
