@@ -23,7 +23,7 @@ def test_flutter_options_defaults_and_validation():
     o = FlutterOptions.from_mapping({}, "flutter")
     assert o.aerodynamics == "theodorsen" and o.pairs == "all" and o.max_speed_m_s == 150.0
     assert isinstance(o.aerodynamic_model(), Theodorsen)
-    for bad, key in [({"aerodynamics": "cfd"}, "flutter.aerodynamics"),
+    for bad, key in [({"aerodynamics": "vortex_lattice"}, "flutter.aerodynamics"),
                      ({"max_speed_m_s": -5}, "flutter.max_speed_m_s"),
                      ({"pairs": "some"}, "flutter.pairs"), ({"speed_steps": 3}, "flutter.speed_steps"),
                      ({"colour": "red"}, "flutter.colour"), ({"aerodynamics": "table"}, "flutter.table_path"),
