@@ -76,7 +76,8 @@ def stage_key(name: str, scenario: Any, upstream_keys: Mapping[str, str], quick:
 
     stage = STAGES[name]
     skip = set(IDENTITY_FIELDS) | set(stage.ignores) | ({"name"} if stage.shared else set())
-    inputs = {k: v for k, v in scenario_fields(scenario).items()
+    inputs = {k: (v.tolist() if hasattr(v, "tolist") else v)
+              for k, v in scenario_fields(scenario, include_none=True).items()
               if (top := k.split(".")[0].split("[")[0]) not in skip and (stage.uses is None or top in stage.uses)}
     files = {}
     base = Path(scenario.source_path).parent if getattr(scenario, "source_path", None) else Path.cwd()

@@ -566,8 +566,13 @@ def load_scenario(name_or_path: str | Path, main_span_m: float | None = None,
     return scenario
 
 
-def scenario_fields(obj: Any) -> dict[str, Any]:
-    """Flatten a dataclass tree into ``{"geometry.main_span_m": 1624.0, ...}`` (for reports and HDF5 attrs)."""
+def scenario_fields(obj: Any, include_none: bool = False) -> dict[str, Any]:
+    """Flatten a dataclass tree into ``{"geometry.main_span_m": 1624.0, ...}`` (for reports, HDF5 attrs
+    and the stage cache's keys): numbers, strings and flags, sequences of them (as lists) and arrays
+    (as NumPy arrays); with ``include_none`` also the fields left unset (None), which the cache key
+    needs to tell "not given" from a value."""
+    import numpy as np
+
     out: dict[str, Any] = {}
 
     def walk(prefix: str, value: Any) -> None:
@@ -580,8 +585,15 @@ def scenario_fields(obj: Any) -> dict[str, Any]:
         elif isinstance(value, (tuple, list)) and value and hasattr(value[0], "__dataclass_fields__"):
             for i, v in enumerate(value):
                 walk(f"{prefix}[{i}]", v)
-        elif isinstance(value, (int, float, str)) and not isinstance(value, bool):
+        elif isinstance(value, np.ndarray):
             out[prefix] = value
+        elif isinstance(value, (tuple, list)) and all(isinstance(v, (bool, int, float, str)) for v in value):
+            if value:
+                out[prefix] = list(value)
+        elif isinstance(value, (bool, int, float, str, np.bool_)):
+            out[prefix] = value
+        elif value is None and include_none:
+            out[prefix] = None
 
     walk("", obj)
     return out

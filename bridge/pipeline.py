@@ -17,7 +17,7 @@ from .errors import InputError
 from .results import write_results
 from .stages import STAGES, RunOptions, StageOutput, resolve_stage
 
-__all__ = ["plan_stages", "run_stages", "run_scenario", "default_stages"]
+__all__ = ["plan_stages", "run_stages", "run_scenario", "default_stages", "stage_keys", "wants_cfd"]
 
 # Stages that only make sense for one kind of scenario.
 _KIND_STAGES = {"suspension_bridge": ("cable", "fem", "aero", "flutter"), "section": ("aero", "flutter"),
@@ -65,6 +65,18 @@ def plan_stages(scenario: Scenario, requested: Iterable[str] | None) -> tuple[st
             raise InputError("--stages", name, f"not available for a scenario of kind {scenario.kind!r} "
                              f"(available: {', '.join(s for s in allowed if s in STAGES)})")
     return tuple(s for s in STAGES if s in needed)
+
+
+def stage_keys(scenario: Scenario, stages: Iterable[str] | None = None,
+               options: RunOptions | None = None) -> dict[str, str]:
+    """The cache key of every planned stage (:func:`bridge.cache.stage_key`), computed without running:
+    what a result of these stages depends on (inputs, input files, code, options)."""
+    options = options or RunOptions()
+    keys: dict[str, str] = {}
+    for name in plan_stages(scenario, stages):
+        keys[name] = cache.stage_key(name, scenario, {d: keys[d] for d in STAGES[name].needs if d in keys},
+                                     options.quick, options.quality if name == "aero" else None)
+    return keys
 
 
 def run_stages(scenario: Scenario, stages: Iterable[str] | None = None,

@@ -15,6 +15,7 @@ The HDF5 schema is documented in ``docs/results.md``.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import os
@@ -125,6 +126,12 @@ def _written_by_us(folder: Path) -> set[str]:
     if isinstance(listed, list):
         return {n for n in listed if isinstance(n, str) and "/" not in n}
     try:
+        summary = json.loads((folder / "summary.json").read_text())
+    except (OSError, ValueError):
+        return set()
+    if not (isinstance(summary, dict) and "scenario.name" in summary and "stages" in summary):
+        return set()   # not a summary this program wrote: nothing in the folder is ours
+    try:
         report = (folder / "report.md").read_text()
     except OSError:
         report = ""
@@ -162,23 +169,40 @@ def _swap_into_place(tmp: Path, final: Path, new_files: set[str]) -> None:
                          "move it away first (it would be replaced)")
     moved: list[str] = []
     old: Path | None = None
+    with _no_interrupts():   # a few renames: Ctrl-C waits for them, so no entry is left half-moved
+        try:
+            for p in keep:
+                moved.append(p.name)   # before the move: an entry is never out of its folder unrecorded
+                os.replace(p, tmp / p.name)
+            old = Path(tempfile.mkdtemp(prefix=f".{final.name}.", suffix=".old", dir=final.parent))
+            os.replace(final, old / "previous")
+            os.replace(tmp, final)
+        except BaseException:
+            if old is not None and not final.exists() and (old / "previous").exists():
+                os.replace(old / "previous", final)
+            for n in moved:  # the user's entries back where they were
+                if (tmp / n).exists():
+                    os.replace(tmp / n, final / n)
+            if old is not None:
+                shutil.rmtree(old, ignore_errors=True)
+            raise
+        shutil.rmtree(old, ignore_errors=True)
+
+
+@contextlib.contextmanager
+def _no_interrupts():
+    """Hold SIGINT back (delivered on leaving) in the main thread; elsewhere a no-op."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread() or not hasattr(signal, "pthread_sigmask"):
+        yield
+        return
+    previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
     try:
-        for p in keep:
-            os.replace(p, tmp / p.name)
-            moved.append(p.name)
-        old = Path(tempfile.mkdtemp(prefix=f".{final.name}.", suffix=".old", dir=final.parent))
-        os.replace(final, old / "previous")
-        os.replace(tmp, final)
-    except BaseException:
-        if old is not None and not final.exists() and (old / "previous").exists():
-            os.replace(old / "previous", final)
-        for n in moved:  # the user's entries back where they were
-            if (tmp / n).exists():
-                os.replace(tmp / n, final / n)
-        if old is not None:
-            shutil.rmtree(old, ignore_errors=True)
-        raise
-    shutil.rmtree(old, ignore_errors=True)
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
 
 
 def write_results(out_root: Path, scenario: Scenario, outputs: Mapping[str, StageOutput],

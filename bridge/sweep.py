@@ -41,7 +41,7 @@ from typing import Any
 
 import numpy as np
 
-from .config import load_scenario
+from .config import check_name, load_scenario
 from .errors import ConvergenceError, InputError
 from .interrupts import Interrupts, exit_command
 
@@ -86,18 +86,17 @@ def plan_cases(scenario: str, spans: Sequence[float] | None, vary: dict[str, lis
 
 
 def case_key(case: Case, stages: list[str] | None, quick: bool) -> str:
-    """What a finished case must have been run with to be skipped on resume: the validated inputs of its
-    scenario, the planned stages, ``quick`` and the program version (SHA-256)."""
+    """What a finished case must have been run with to be skipped on resume: the cache keys of its planned
+    stages (their inputs, the input files they read, their code, ``quick``) and the program version."""
     import hashlib
 
     from . import __version__
-    from .config import scenario_fields
-    from .pipeline import plan_stages
+    from .pipeline import stage_keys
+    from .stages import RunOptions
 
     sc = load_scenario(case.scenario, main_span_m=case.main_span_m, overrides=dict(case.overrides))
-    blob = json.dumps({"inputs": {k: v for k, v in scenario_fields(sc).items() if k not in ("name", "source_path")},
-                       "stages": list(plan_stages(sc, stages)), "quick": bool(quick), "version": __version__},
-                      sort_keys=True, default=repr)
+    keys = stage_keys(sc, stages, RunOptions(quick=quick))
+    blob = json.dumps({"stages": keys, "version": __version__}, sort_keys=True)
     return hashlib.sha256(blob.encode()).hexdigest()
 
 
@@ -140,6 +139,8 @@ def run_case(case: Case, out_dir: str, stages: list[str] | None, quick: bool,
                                   overwrite=True, run_key=key)
     except (InputError, ConvergenceError) as err:
         return case.name, f"error: {err}"
+    except Exception as err:   # any other failure of one case is that case's error: the others go on
+        return case.name, f"error: {type(err).__name__}: {err}"
     except KeyboardInterrupt:
         if not in_worker:
             raise
@@ -162,10 +163,12 @@ def _label(key: str) -> str:
     return next((label for k, label, _ in COMPARISON_ROWS if k == key), key)
 
 
-def collect(cases: list[Case], cases_dir: Path, sweep_dir: Path, plot_key: str | None) -> Path:
+def collect(cases: list[Case], cases_dir: Path, sweep_dir: Path, plot_key: str | None,
+            keys: dict[str, str] | None = None) -> Path:
     """Gather every finished case's summary into ``sweep.h5`` and ``sweep.csv`` and plot ``plot_key``
     against the main span (``sweep.png``).  A ``plot_key`` that is no numeric result of any finished
-    case is an InputError, raised before anything is written."""
+    case is an InputError, raised before anything is written.  With ``keys`` (case name -> run key) a
+    case folder holding a run of other inputs counts as not finished."""
     import csv
     import io
 
@@ -176,7 +179,10 @@ def collect(cases: list[Case], cases_dir: Path, sweep_dir: Path, plot_key: str |
     rows = []
     for c in cases:
         f = cases_dir / c.name / "summary.json"
-        rows.append(json.loads(f.read_text()) if f.is_file() else None)
+        row = json.loads(f.read_text()) if f.is_file() else None
+        if row is not None and keys is not None and row.get("run.key") != keys.get(c.name):
+            row = None   # a result of other inputs (this run's case failed): not this sweep's
+        rows.append(row)
     numeric = sorted({k for r in rows if r for k, v in r.items()
                       if isinstance(v, (int, float)) and not isinstance(v, bool)})
     if plot_key is not None and plot_key not in numeric:
@@ -355,6 +361,14 @@ def main(argv: Sequence[str] | None = None) -> int:
                     raise InputError("--vary", item, "needs at least one value after '='")
             stages = parse_stages(args.stages)
             cases = plan_cases(args.scenario, spans, vary)
+            seen: dict[str, Case] = {}
+            for c in cases:
+                if c.name in seen:
+                    raise InputError("--main-span/--vary", c.name, "two cases of the sweep get this one name "
+                                     "(a value given twice, or values that print alike): make them distinct")
+                seen[c.name] = c
+            if args.name is not None:
+                check_name(args.name, "--name")
             planned: set[str] = set()
             for c in cases:  # check every case's input and stages before running any
                 sc = load_scenario(c.scenario, main_span_m=c.main_span_m, overrides=dict(c.overrides))
@@ -366,7 +380,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             sweep_dir = args.out / (args.name or f"sweep_{Path(args.scenario).stem}")
             status = run_sweep(cases, sweep_dir, stages, args.quick, args.workers, args.scheduler, say,
                                cache_dir=None if args.no_cache else args.out / ".cache")
-            table = collect(cases, sweep_dir / "cases", sweep_dir, args.plot)
+            keys = {c.name: case_key(c, stages, args.quick) for c in cases}
+            table = collect(cases, sweep_dir / "cases", sweep_dir, args.plot, keys)
             failed = {k: v for k, v in status.items() if v.startswith("error")}
             print(f"sweep table: {table} (also {table.with_suffix('.csv').name}, "
                   f"{'sweep.png' if (sweep_dir / 'sweep.png').is_file() else 'no plot'})")

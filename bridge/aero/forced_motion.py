@@ -175,10 +175,19 @@ def _grid(q: Quality, reach: float):
     return CartesianGrid(x, y)
 
 
-def case_key(section_polygon, case: ForcedCase, q: Quality) -> str:
-    """What a checkpoint must match to be resumed: the geometry, the case and the preset."""
-    blob = json.dumps({"verts": np.round(section_polygon.vertices, 12).tolist(), "case": asdict(case),
-                       "quality": asdict(q)}, sort_keys=True)
+def _polygons(shape) -> list:
+    """A Polygon or a list of them (a deck with railings) as a list."""
+    return list(shape) if isinstance(shape, (list, tuple)) else [shape]
+
+
+def case_key(shape, case: ForcedCase, q: Quality) -> str:
+    """What a checkpoint must match to be resumed: the geometry, the case, the preset and the source of
+    the solver (a changed CFD code never resumes an old run)."""
+    from bridge.cache import _code_digest
+
+    blob = json.dumps({"verts": [np.round(p.vertices, 12).tolist() for p in _polygons(shape)], "case": asdict(case),
+                       "quality": asdict(q), "code": _code_digest(("bridge.cfd", "kernels.cfd",
+                                                                    "bridge.aero.forced_motion"))}, sort_keys=True)
     return hashlib.sha256(blob.encode()).hexdigest()
 
 
@@ -216,30 +225,34 @@ def _load_checkpoint(path: Path, key: str, sim) -> dict | None:
             sim.t = float(h5.attrs["t"])
             sim.n_steps = int(h5.attrs["n_steps"])
             return {name: list(h5[f"record/{name}"][()]) for name in h5["record"]}
-    except (OSError, KeyError):
+    except (OSError, KeyError, ValueError):   # unreadable or of another grid: start afresh
         return None
 
 
-def run_case(polygon, case: ForcedCase, quality: Quality, checkpoint: Path | None = None,
+def run_case(shape, case: ForcedCase, quality: Quality, checkpoint: Path | None = None,
              checkpoint_every: int = 2000, threads: int | None = None,
              progress: Callable[[str], None] | None = None, label: str = "") -> ForceRecord:
     """Run one forced-motion case for ``quality.periods`` periods of its fundamental; return the whole
-    force record (the caller discards ``quality.discard_periods``).  Resumes from ``checkpoint`` if it
-    holds this case (:func:`case_key`); progress lines about every 10 % of the run.  ``threads``: CPU
-    threads of the step (default 2, but 1 below 20 000 cells, where waiting for the second thread
+    force record (the caller discards ``quality.discard_periods``).  ``shape``: the section's polygon,
+    or a list of polygons moving together (a box with railings); the loads are their sum.  Resumes from
+    ``checkpoint`` if it holds this case (:func:`case_key`); progress lines about every 10 % of the run.
+    ``threads``: CPU threads of the step (default 2, but 1 below 20 000 cells, where waiting for the second thread
     costs more than it saves; the numbers do not depend on it)."""
     from bridge.cfd import BoundaryConditions, FlowConfig, NaNMonitor, Simulation
 
     q = quality
-    amp = sum(abs(a) for a in case.amplitudes) * (1.0 if case.dof == "heave" else polygon.radius)
-    grid = _grid(q, float(np.abs(polygon.vertices[:, 1]).max()) + amp)
+    polys = _polygons(shape)
+    radius = max(p.radius for p in polys)
+    amp = sum(abs(a) for a in case.amplitudes) * (1.0 if case.dof == "heave" else radius)
+    grid = _grid(q, max(float(np.abs(p.vertices[:, 1]).max()) for p in polys) + amp)
     bc = BoundaryConditions(left="inflow", right="outflow", bottom="slip", top="slip")
     if threads is None:
         threads = 1 if grid.nx * grid.ny < 20_000 else 2
     sim = Simulation(grid, FlowConfig(nu=1.0 / q.reynolds, advection="vanleer", cfl=q.cfl, threads=threads, bc=bc))
-    sim.add_body(polygon, case.motion())
+    for p in polys:
+        sim.add_body(p, case.motion())
     sim.set_state(u=1.0)
-    key = case_key(polygon, case, q)
+    key = case_key(polys, case, q)
     names = ("t", "lift", "drag", "moment", "motion")
     rec = {n: [] for n in names}
     resumed = 0
@@ -258,7 +271,7 @@ def run_case(polygon, case: ForcedCase, quality: Quality, checkpoint: Path | Non
     next_note = sim.t + 0.1 * t_end
     while sim.t < t_end - 1e-12 * t_end:
         sim.step(sim.stable_dt())
-        fx, fy, mz = sim.last_force[0]
+        fx, fy, mz = np.sum(sim.last_force, axis=0)   # all parts about the same reference point
         rec["t"].append(sim.t)
         rec["lift"].append(fy)
         rec["drag"].append(fx)

@@ -59,10 +59,15 @@ class AeroResult:
 
 
 def _unit_polygon(section):
-    """The section scaled to chord 1 (the CFD's unit of length)."""
+    """The section's outline scaled to chord 1 (the CFD's unit of length)."""
+    return _unit_polygons(section)[0]
+
+
+def _unit_polygons(section) -> list:
+    """Every part of the section (the box and, if any, its railings) scaled to chord 1."""
     from bridge.cfd import Polygon
 
-    return Polygon(section.polygon().vertices / section.chord_m)
+    return [Polygon(p.vertices / section.chord_m) for p in section.polygons()]
 
 
 def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
@@ -72,7 +77,7 @@ def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
     aopts: AeroOptions = getattr(scenario, "aero", None) or AeroOptions()
     quality = options.quality or ("tiny" if options.quick else aopts.quality)
     q = QUALITY[quality]
-    poly = _unit_polygon(section)
+    poly = _unit_polygons(section)
     cells_across = (section.depth_m / section.chord_m) * q.cells_per_chord / q.dy_over_dx
     warning = ("" if cells_across >= 2.0 else
                f"the section is {cells_across:.1f} cells thick on the {quality!r} grid (fewer than 2): the immersed "

@@ -89,3 +89,16 @@ def test_the_aero_stage_feeds_flutter_and_bridges_with_one_deck_share_it(tmp_pat
     np.testing.assert_array_equal(out_b["aero"].data.frf.h_pu, aero.frf.h_pu)
     # the cases left their checkpoints, so a re-run after a kill would resume
     assert len(list((tmp_path / "cache" / "aero-runs").glob("*.h5"))) == 4
+
+
+def test_a_checkpoint_of_other_solver_code_is_not_resumed(monkeypatch):
+    """The checkpoint's key holds the source of the solver: a changed CFD never continues an old run."""
+    from bridge import cache
+    from bridge.aero.forced_motion import case_key
+
+    poly = _unit_polygon(Rectangle(10.0, 2.0))
+    case = ForcedCase("heave", (2.5,), (0.005,))
+    before = case_key(poly, case, QUALITY["tiny"])
+    monkeypatch.setattr(cache, "_code_digest", lambda modules: "edited")
+    assert case_key(poly, case, QUALITY["tiny"]) != before
+

@@ -16,6 +16,7 @@ from pathlib import Path
 import pytest
 
 from bridge.config import SCENARIO_DIR
+from bridge.sweep import plan_cases
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -81,6 +82,19 @@ def test_a_users_file_named_like_an_output_is_never_overwritten(tmp_path):
     assert "fem_mode_S-V1.png" in line
     assert (tmp_path / "great_belt" / "fem_mode_S-V1.png").read_bytes() == b"my own picture"
     assert strict_json(tmp_path / "great_belt" / "summary.json")["stages"] == ["cable"]
+
+
+def test_a_folder_whose_summary_is_not_ours_is_not_ours(tmp_path):
+    """--overwrite trusts only a summary.json this program wrote (with scenario.name and stages): a folder
+    of another tool's files named like ours is refused, its files untouched."""
+    folder = tmp_path / "great_belt"
+    folder.mkdir()
+    (folder / "summary.json").write_text('{"score": 3}')
+    (folder / "results.h5").write_bytes(b"another tool's file")
+    line = one_error_line(cli("great_belt", "--stages", "cable", "--quick", "--quiet", "--overwrite",
+                              "--out", str(tmp_path)))
+    assert "not written by the program" in line
+    assert (folder / "results.h5").read_bytes() == b"another tool's file"
 
 
 def test_the_name_is_the_files_own_and_checked(tmp_path):
@@ -250,6 +264,30 @@ def test_sweep_resumes_only_cases_run_with_the_same_stages(tmp_path):
     assert "skipped" in cli(*base, "--stages", "fem", module="bridge.sweep").stderr
 
 
+def test_sweep_refuses_cases_of_one_name_and_a_bad_sweep_name(tmp_path):
+    base = ["great_belt", "--stages", "cable", "--quick", "--workers", "1", "--out", str(tmp_path)]
+    line = one_error_line(cli(*base, "--main-span", "1624,1624", module="bridge.sweep"))
+    assert "one name" in line
+    line = one_error_line(cli(*base, "--main-span", "1624", "--name", "../outside", module="bridge.sweep"))
+    assert line.startswith("error: --name")
+    assert not list(tmp_path.iterdir())
+
+
+def test_sweep_table_counts_only_cases_of_the_current_inputs(tmp_path):
+    from bridge.sweep import collect
+
+    cases = plan_cases("great_belt", [1624.0, 2000.0], {})
+    for c, key in zip(cases, ["now", "earlier"], strict=True):
+        (tmp_path / "cases" / c.name).mkdir(parents=True)
+        (tmp_path / "cases" / c.name / "summary.json").write_text(json.dumps(
+            {"scenario.main_span_m": c.main_span_m, "cable.area_m2": 0.41, "run.key": key}))
+    collect(cases, tmp_path / "cases", tmp_path, None, keys={c.name: "now" for c in cases})
+    import h5py
+
+    with h5py.File(tmp_path / "sweep.h5") as h5:
+        assert h5["finished"][:].tolist() == [True, False]
+
+
 def test_sweep_checks_stages_and_plot_key_before_running(tmp_path):
     base = ["great_belt", "--main-span", "1624,2000", "--quick", "--workers", "1", "--out", str(tmp_path)]
     line = one_error_line(cli(*base, "--stages", "bogus", module="bridge.sweep"))
@@ -336,6 +374,18 @@ def test_stage_key_follows_code_inputs_upstream_and_input_files(tmp_path):
     assert k != stage_key("flutter", sc, {"fem": "b"}, quick=False)   # upstream output differs
     assert k != stage_key("flutter", sc, {"fem": "a"}, quick=True)
     assert stage_key("cable", sc, {}, False) == stage_key("cable", replace(sc, flutter=FlutterOptions()), {}, False)
+    # every kind of input is in the key: arrays of given modes, flags, sequences of numbers
+    import numpy as np
+
+    from bridge.aero.options import AeroOptions
+
+    modal = load_scenario("great_belt_thesis_modes")
+    stiffer = replace(modal, modal=replace(modal.modal, frequencies_hz=np.array([0.128, 0.35])))
+    assert stage_key("flutter", modal, {}, False) != stage_key("flutter", stiffer, {}, False)
+    no_pk = replace(modal, flutter=replace(modal.flutter, multimode=False))
+    assert stage_key("flutter", modal, {}, False) != stage_key("flutter", no_pk, {}, False)
+    a, b = replace(sc, aero=AeroOptions()), replace(sc, aero=AeroOptions(reduced_velocities=(5.0, 9.0)))
+    assert stage_key("aero", a, {}, False) != stage_key("aero", b, {}, False)
     # the bytes of a file the scenario names are part of the key
     csv = tmp_path / "derivatives.csv"
     csv.write_text("K,H1\n1,2\n")
