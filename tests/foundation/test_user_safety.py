@@ -331,6 +331,7 @@ def test_ctrl_c_is_one_line_and_exit_130(tmp_path, module, args):
 
 
 # ------------------------------------------------------------------------------ stage cache
+@pytest.mark.slow  # ~17 s (five runs of the pipeline): runs in CI with -m slow; the keys are checked below
 def test_stage_cache_reuses_unchanged_stages_only(tmp_path):
     out = str(tmp_path / "out")
     first = cli("great_belt", "--quick", "--out", out)
