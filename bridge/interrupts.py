@@ -61,6 +61,16 @@ class Interrupts:
         with contextlib.suppress(ValueError):
             signal.signal(signal.SIGINT, signal.SIG_IGN)
 
+    def reported(self, message) -> int:
+        """After an exception: if it came from the interrupt, print ``message()`` (one line: what was
+        kept) and return the exit status 130; otherwise re-raise it.  Call from an ``except
+        BaseException`` block."""
+        if not self.fired:
+            raise
+        self.finish()
+        print(message(), file=sys.stderr)
+        return INTERRUPTED
+
     def _redeliver(self) -> None:
         if not self.finished:
             os.kill(os.getpid(), signal.SIGINT)

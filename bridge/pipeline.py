@@ -89,13 +89,11 @@ def run_stages(scenario: Scenario, stages: Iterable[str] | None = None,
     """
     options = options or RunOptions()
     outputs: dict[str, StageOutput] = {}
-    keys: dict[str, str] = {}
+    keys = stage_keys(scenario, stages, options) if options.cache is not None else {}
     for name in plan_stages(scenario, stages):
         if options.cache is None:
             outputs[name] = resolve_stage(name)(scenario, outputs, options)
             continue
-        keys[name] = cache.stage_key(name, scenario, {d: keys[d] for d in STAGES[name].needs if d in keys},
-                                     options.quick, options.quality if name == "aero" else None)
         hit = cache.load(options.cache, name, keys[name])
         if hit is not None:
             options.say(f"[{scenario.name}] {name}: inputs unchanged, reusing the stored result "

@@ -149,14 +149,12 @@ def main(argv: Sequence[str] | None = None) -> int:
             print(f"error: {err}", file=sys.stderr)
             return 3
         except BaseException:
-            if not interrupts.fired:
-                raise
-            interrupts.finish()
-            kept = f"kept: {', '.join(map(str, written))}" if written else "no result folder written"
-            stored = not args.no_cache and any((args.out / ".cache").glob("*/*/output.pkl"))
-            cache = f"; finished stages stay in {args.out / '.cache'}" if stored else ""
-            print(f"interrupted; {kept}{cache}", file=sys.stderr)
-            return 130
+            def kept() -> str:
+                folders = f"kept: {', '.join(map(str, written))}" if written else "no result folder written"
+                stored = not args.no_cache and any((args.out / ".cache").glob("*/*/output.pkl"))
+                cached = f"; finished stages stay in {args.out / '.cache'}" if stored else ""
+                return f"interrupted; {folders}{cached}"
+            return interrupts.reported(kept)
 
 
 def _run(args: argparse.Namespace, say, written: list[Path]) -> int:

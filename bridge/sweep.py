@@ -392,12 +392,9 @@ def main(argv: Sequence[str] | None = None) -> int:
             print(f"error: {err}", file=sys.stderr)
             return 2
         except BaseException:
-            if not interrupts.fired:
-                raise
-            interrupts.finish()
             where = f" in {sweep_dir / 'cases'}" if sweep_dir is not None else ""
-            print(f"interrupted; finished cases are kept{where} (the same command resumes)", file=sys.stderr)
-            return 130
+            return interrupts.reported(
+                lambda: f"interrupted; finished cases are kept{where} (the same command resumes)")
 
 
 if __name__ == "__main__":
