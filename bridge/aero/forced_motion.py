@@ -36,7 +36,7 @@ import numpy as np
 
 from bridge.errors import InputError, check_range
 
-__all__ = ["Quality", "QUALITY", "ForcedCase", "ForceRecord", "run_case", "case_key", "whole_periods",
+__all__ = ["Quality", "QUALITY", "ForcedCase", "StaticCase", "ForceRecord", "run_case", "case_key", "whole_periods",
            "THESIS_HEAVE_RATE", "THESIS_PITCH_RATE"]
 
 THESIS_HEAVE_RATE = 0.4 / 50.0            # udot_0 / V (thesis 5.3)
@@ -60,11 +60,13 @@ class Quality:
     stretch: float = 1.08
     periods: int = 5
     discard_periods: int = 2
+    static_duration: float = 30.0   # a section held still: run length in convective times B / V
 
     def __post_init__(self):
         check_range("aero.cells_per_chord", self.cells_per_chord, 8, 2000)
         check_range("aero.dy_over_dx", self.dy_over_dx, 0.05, 1.0)
         check_range("aero.reynolds", self.reynolds, 1.0, 1e6)
+        check_range("aero.static_duration", self.static_duration, 1.0, 1e4)
         if not (0 < self.discard_periods < self.periods):
             raise InputError("aero.discard_periods", self.discard_periods,
                              f"must be >= 1 and below periods ({self.periods})")
@@ -73,12 +75,13 @@ class Quality:
 # Presets.  The laminar solver cannot run the deck's Reynolds number (1e8): the presets use a low one
 # and say so; the k-omega SST model of the turbulence issue will lift that limit.
 QUALITY = {
-    "tiny": Quality("tiny", 12, 0.5, 1.0, 2.0, 1.0, 0.25, 500.0, periods=3, discard_periods=1),
+    "tiny": Quality("tiny", 12, 0.5, 1.0, 2.0, 1.0, 0.25, 500.0, periods=3, discard_periods=1, static_duration=6.0),
     "quick": Quality("quick", 40, 0.25, 2.0, 10.0, 2.0, 0.2, 1000.0, periods=4, discard_periods=2),
     # the wake must be long: with 3 chords of it the lift of a pitching plate came out 25 % high, with 10
     # chords 13 %, with 20 chords within 0.3 % of Theodorsen (docs/aero.md)
     "standard": Quality("standard", 40, 0.25, 3.0, 20.0, 3.0, 0.2, 1000.0, periods=4, discard_periods=2),
-    "fine": Quality("fine", 80, 0.25, 3.0, 20.0, 3.0, 0.2, 2000.0, periods=5, discard_periods=2),
+    "fine": Quality("fine", 80, 0.25, 3.0, 20.0, 3.0, 0.2, 2000.0, periods=5, discard_periods=2,
+                    static_duration=40.0),
 }
 
 
@@ -143,6 +146,50 @@ class ForcedCase:
                                     lambda t: (0.0, self.rate(t), 0.0))
         return PrescribedMotion(lambda t: (0.0, 0.0, -self.displacement(t)),
                                 lambda t: (0.0, 0.0, -self.rate(t)))
+
+    def end_time(self, q: Quality) -> float:
+        """``q.periods`` periods of the fundamental."""
+        return q.periods * 2 * math.pi / self.fundamental
+
+    def excursion(self, radius: float) -> float:
+        """Largest vertical travel of a point of the body (``radius``: its farthest point from the axis)."""
+        return sum(abs(a) for a in self.amplitudes) * (1.0 if self.dof == "heave" else radius)
+
+    def progress(self, t: float, q: Quality) -> str:
+        return f"{t * self.fundamental / (2 * math.pi):.1f} of {q.periods} periods"
+
+
+@dataclass(frozen=True)
+class StaticCase:
+    """The section held still at the angle of attack ``angle_deg`` (degrees, nose-up) in the uniform wind,
+    for the preset's ``static_duration``: static coefficients and the wake's shedding frequency."""
+
+    angle_deg: float
+    grid_angle_deg: float = 0.0   # the grid is made for angles up to this (one grid for a sweep of angles)
+    dof: str = field(default="static", init=False)
+
+    def __post_init__(self):
+        check_range("aero.static_angles_deg", self.angle_deg, -30.0, 30.0)
+        object.__setattr__(self, "angle_deg", float(self.angle_deg))
+        object.__setattr__(self, "grid_angle_deg", max(abs(float(self.grid_angle_deg)), abs(self.angle_deg)))
+
+    def displacement(self, t: float) -> float:
+        return math.radians(self.angle_deg)
+
+    def motion(self):
+        """Fixed, rotated nose-up (clockwise in the CFD frame) about the reference point."""
+        from bridge.cfd import Stationary
+
+        return Stationary(0.0, 0.0, -math.radians(self.angle_deg))
+
+    def end_time(self, q: Quality) -> float:
+        return q.static_duration
+
+    def excursion(self, radius: float) -> float:
+        return math.sin(math.radians(self.grid_angle_deg)) * radius
+
+    def progress(self, t: float, q: Quality) -> str:
+        return f"angle {self.angle_deg:g} deg held"
 
 
 @dataclass
@@ -229,11 +276,12 @@ def _load_checkpoint(path: Path, key: str, sim) -> dict | None:
         return None
 
 
-def run_case(shape, case: ForcedCase, quality: Quality, checkpoint: Path | None = None,
+def run_case(shape, case: ForcedCase | StaticCase, quality: Quality, checkpoint: Path | None = None,
              checkpoint_every: int = 2000, threads: int | None = None,
              progress: Callable[[str], None] | None = None, label: str = "") -> ForceRecord:
-    """Run one forced-motion case for ``quality.periods`` periods of its fundamental; return the whole
-    force record (the caller discards ``quality.discard_periods``).  ``shape``: the section's polygon,
+    """Run one case - forced motion for ``quality.periods`` periods of its fundamental (the caller discards
+    ``quality.discard_periods``), or a section held still for ``quality.static_duration`` - and return the
+    whole force record.  ``shape``: the section's polygon,
     or a list of polygons moving together (a box with railings); the loads are their sum.  Resumes from
     ``checkpoint`` if it holds this case (:func:`case_key`); progress lines about every 10 % of the run.
     ``threads``: CPU threads of the step (default 2, but 1 below 20 000 cells, where waiting for the second thread
@@ -243,8 +291,7 @@ def run_case(shape, case: ForcedCase, quality: Quality, checkpoint: Path | None 
     q = quality
     polys = _polygons(shape)
     radius = max(p.radius for p in polys)
-    amp = sum(abs(a) for a in case.amplitudes) * (1.0 if case.dof == "heave" else radius)
-    grid = _grid(q, max(float(np.abs(p.vertices[:, 1]).max()) for p in polys) + amp)
+    grid = _grid(q, max(float(np.abs(p.vertices[:, 1]).max()) for p in polys) + case.excursion(radius))
     bc = BoundaryConditions(left="inflow", right="outflow", bottom="slip", top="slip")
     if threads is None:
         threads = 1 if grid.nx * grid.ny < 20_000 else 2
@@ -265,7 +312,7 @@ def run_case(shape, case: ForcedCase, quality: Quality, checkpoint: Path | None 
             resumed = sim.n_steps
             if progress:
                 progress(f"{label}: resuming at t = {sim.t:.2f} (step {resumed}) from {checkpoint}")
-    t_end = q.periods * 2 * math.pi / case.fundamental
+    t_end = case.end_time(q)
     nan = NaNMonitor(every=200)
     t0, t_start = time.perf_counter(), sim.t
     next_note = sim.t + 0.1 * t_end
@@ -282,18 +329,16 @@ def run_case(shape, case: ForcedCase, quality: Quality, checkpoint: Path | None 
             _save_checkpoint(checkpoint, key, sim, rec)
         if progress and sim.t >= next_note:
             done = sim.t / t_end
-            left = (time.perf_counter() - t0) / max(sim.t - t_start, 1e-12) * (t_end - sim.t)
+            left = (time.perf_counter() - t0) / max(sim.t - t_start, 1e-12) * max(t_end - sim.t, 0.0)
             progress(f"{label}: t = {sim.t:.1f} of {t_end:.1f} ({100 * done:.0f} %, "
-                     f"{sim.t * case.fundamental / (2 * math.pi):.1f} of {q.periods} periods), "
-                     f"{grid.nx} x {grid.ny} cells, about {left:.0f} s left")
+                     f"{case.progress(sim.t, q)}), {grid.nx} x {grid.ny} cells, about {left:.0f} s left")
             next_note += 0.1 * t_end
     if checkpoint is not None:
         _save_checkpoint(checkpoint, key, sim, rec)
     arrays = {n: np.asarray(v, dtype=np.float64) for n, v in rec.items()}
     return ForceRecord(**arrays, steps=sim.n_steps, wall_s=time.perf_counter() - t0, resumed_from_step=resumed,
                        meta={"nx": grid.nx, "ny": grid.ny, "reynolds": q.reynolds, "quality": q.name,
-                             "dof": case.dof, "reduced_frequencies": list(case.reduced_frequencies),
-                             "amplitudes": list(case.amplitudes), "phases": list(case.phases)})
+                             **asdict(case)})
 
 
 def whole_periods(record: ForceRecord, case: ForcedCase, discard: int) -> np.ndarray:

@@ -10,6 +10,10 @@ Keys (all optional):
                           0.4 / 50 = 0.008, thesis 5.3)
     pitch_rate            rotation-rate amplitude thetadot_0 B / V (default the thesis's 0.028 * 31 / 50)
     checkpoint_every      steps between checkpoints of a running case (default 2000)
+    static_angles_deg     angles of attack (degrees, nose-up) at which the section is held still for its
+                          static coefficients C_D, C_L, C_M, their slopes and the Strouhal number
+                          (default -2, 0, 2; [] skips them); with aerodynamics = "cfd" they supply the
+                          lateral (drag, sway) terms of the flutter model (bridge/aero/static.py)
 """
 
 from __future__ import annotations
@@ -32,6 +36,7 @@ class AeroOptions:
     heave_rate: float = 0.4 / 50.0
     pitch_rate: float = 0.028 * 31.0 / 50.0
     checkpoint_every: int = 2000
+    static_angles_deg: tuple[float, ...] = (-2.0, 0.0, 2.0)
 
     def __post_init__(self):
         from bridge.aero.forced_motion import QUALITY
@@ -50,6 +55,15 @@ class AeroOptions:
         if isinstance(self.checkpoint_every, bool) or not isinstance(self.checkpoint_every, int) \
                 or self.checkpoint_every < 10:
             raise InputError("aero.checkpoint_every", self.checkpoint_every, "an integer >= 10")
+        angles = self.static_angles_deg
+        if isinstance(angles, (str, bytes)) or not isinstance(angles, (list, tuple)) or len(angles) == 1:
+            raise InputError("aero.static_angles_deg", angles, "a list of angles in degrees: none, or at least 2 "
+                             "(the slopes need two)")
+        angles = tuple(sorted(check_range(f"aero.static_angles_deg[{i}]", a, -30.0, 30.0)
+                              for i, a in enumerate(angles)))
+        if len(set(angles)) != len(angles):
+            raise InputError("aero.static_angles_deg", self.static_angles_deg, "distinct values")
+        object.__setattr__(self, "static_angles_deg", angles)
 
     @classmethod
     def from_mapping(cls, mapping: Mapping[str, Any], where: str = "aero") -> AeroOptions:
@@ -60,6 +74,7 @@ class AeroOptions:
             if key not in allowed:
                 raise InputError(f"{where}.{key}", mapping[key], f"unknown key; allowed: {', '.join(allowed)}")
         values = dict(mapping)
-        if "reduced_velocities" in values and isinstance(values["reduced_velocities"], list):
-            values["reduced_velocities"] = tuple(values["reduced_velocities"])
+        for key in ("reduced_velocities", "static_angles_deg"):
+            if key in values and isinstance(values[key], list):
+                values[key] = tuple(values[key])
         return cls(**values)

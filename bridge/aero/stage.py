@@ -22,9 +22,11 @@ from typing import Any
 
 import numpy as np
 
-from bridge.aero.forced_motion import QUALITY, ForcedCase, case_key, run_case, whole_periods
+from bridge.aero.forced_motion import QUALITY, ForcedCase, StaticCase, case_key, run_case, whole_periods
 from bridge.aero.frequency_response import forced_motion_response
 from bridge.aero.options import AeroOptions
+from bridge.aero.static import StaticCoefficients, static_coefficients
+from bridge.flutter.aerodynamics import WithLateral
 from bridge.flutter.derivatives import DERIVATIVE_NAMES, FRF, VERTICAL_TORSIONAL, derivatives_from_frf
 from bridge.flutter.tables import DerivativeTable
 from bridge.results import write_dataset
@@ -45,9 +47,11 @@ class AeroResult:
     reduced_frequency: np.ndarray      # K = w B / V, ascending
     frf: FRF                           # arrays over K (vertical-torsional; drag terms when recorded)
     stderr: FRF
-    model: DerivativeTable
+    model: Any                         # DerivativeTable, completed by the static coefficients' lateral terms
     records: tuple[dict, ...]          # per case: dof, K, steps, wall_s, resumed_from_step, periods
     warning: str = ""                  # e.g. the section under-resolved on this preset
+    static: StaticCoefficients | None = None
+    static_records: tuple[dict, ...] = ()   # per static case: angle_deg, steps, wall_s, t, lift, drag, moment
 
     @property
     def reduced_velocity(self) -> np.ndarray:
@@ -111,14 +115,34 @@ def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
                             "resumed_from_step": rec.resumed_from_step, "periods": resp.periods,
                             "t": rec.t, "lift": rec.lift, "moment": rec.moment, "motion": rec.motion,
                             "window": (float(rec.t[sel][0]), float(rec.t[sel][-1]))})
+    static, static_records = _static_runs(poly, section, aopts, q, runs, options)
     frf, stderr = FRF(**values), FRF(**errors)
-    model = DerivativeTable(Ks, derivatives_from_frf(Ks, frf), source=f"cfd ({section.name}, {quality})",
+    table = DerivativeTable(Ks, derivatives_from_frf(Ks, frf), source=f"cfd ({section.name}, {quality})",
                             provides=VERTICAL_TORSIONAL + ("h_qu", "h_qtheta"))
-    model.name = f"cfd ({section.name}, {quality}, Re {q.reynolds:g})"
+    table.name = f"cfd ({section.name}, {quality}, Re {q.reynolds:g})"
+    model = table if static is None else WithLateral(table, static.quasi_steady())
     data = AeroResult(section.describe(), quality, q.reynolds, cells, Ks, frf, stderr, model, tuple(records),
-                      warning)
+                      warning, static, tuple(static_records))
     return StageOutput(summary=_summary(data), write_h5=lambda g: _write_h5(g, data), report=_report(data),
                        figures=_figures(data), data=data)
+
+
+def _static_runs(poly, section, aopts: AeroOptions, q, runs, options: RunOptions):
+    """The section held still at each of ``aopts.static_angles_deg``: (StaticCoefficients or None, records)."""
+    angles = aopts.static_angles_deg
+    if not angles:
+        return None, []
+    records, recs = [], []
+    for n, angle in enumerate(angles):
+        case = StaticCase(angle, grid_angle_deg=max(abs(a) for a in angles))
+        label = f"aero static {n + 1}/{len(angles)}, angle {angle:g} deg"
+        checkpoint = None if runs is None else runs / f"{case_key(poly, case, q)[:24]}.h5"
+        rec = run_case(poly, case, q, checkpoint, aopts.checkpoint_every, progress=options.say, label=label)
+        recs.append(rec)
+        records.append({"angle_deg": angle, "steps": rec.steps, "wall_s": rec.wall_s,
+                        "resumed_from_step": rec.resumed_from_step, "t": rec.t, "lift": rec.lift,
+                        "drag": rec.drag, "moment": rec.moment})
+    return static_coefficients(recs, angles, section.depth_m / section.chord_m), records
 
 
 def _summary(d: AeroResult) -> dict[str, Any]:
@@ -126,7 +150,15 @@ def _summary(d: AeroResult) -> dict[str, Any]:
                          "aero.cases": len(d.records), "aero.grid_cells": d.cells[0] * d.cells[1],
                          "aero.reduced_velocity_min": float(d.reduced_velocity.min()),
                          "aero.reduced_velocity_max": float(d.reduced_velocity.max()),
-                         "aero.cfd_wall_s": float(sum(r["wall_s"] for r in d.records))}
+                         "aero.cfd_wall_s": float(sum(r["wall_s"] for r in d.records + d.static_records))}
+    if d.static is not None:
+        (cd, dcd), (cl, dcl), (cm, dcm) = (d.static.fit(v) for v in (d.static.drag, d.static.lift, d.static.moment))
+        i0 = int(np.argmin(np.abs(d.static.angles_deg)))
+        st = float(d.static.strouhal[i0])
+        s.update({"aero.static.drag_coefficient": cd, "aero.static.drag_slope_per_rad": dcd,
+                  "aero.static.lift_coefficient": cl, "aero.static.lift_slope_per_rad": dcl,
+                  "aero.static.moment_coefficient": cm, "aero.static.moment_slope_per_rad": dcm,
+                  "aero.static.strouhal_on_depth": None if math.isnan(st) else st})
     return s
 
 
@@ -149,6 +181,32 @@ def _write_h5(group: Any, d: AeroResult) -> None:
         if np.any(v):
             write_dataset(group, f"derivatives/{name}", v, "1",
                           f"({n},) Scanlan's {name}* (B form, h and L down, alpha and M nose-up)")
+    if d.static is not None:
+        _write_static_h5(group.create_group("static"), d.static)
+
+
+def _write_static_h5(g: Any, st: StaticCoefficients) -> None:
+    """``results.h5:/aero/static``: coefficients of the section held still (bridge/aero/static.py)."""
+    n = st.angles_deg.size
+    g.attrs["window_start"], g.attrs["window_end"] = st.window
+    g.attrs["depth_over_chord"] = st.depth_over_chord
+    write_dataset(g, "angle_of_attack", st.angles_deg, "deg", f"({n},) angle of attack, nose-up")
+    for name, values, what in (("drag_coefficient", st.drag, "C_D = drag / ((1/2) rho V^2 B), downwind"),
+                               ("lift_coefficient", st.lift, "C_L = lift / ((1/2) rho V^2 B), up"),
+                               ("moment_coefficient", st.moment,
+                                "C_M = moment / ((1/2) rho V^2 B^2), nose-up about the reference point"),
+                               ("lift_rms", st.lift_rms, "rms of the lift coefficient's fluctuation")):
+        write_dataset(g, name, values, "1", f"({n},) {what}, mean over the second half of the run")
+    write_dataset(g, "shedding_frequency", st.frequency, "1",
+                  f"({n},) dominant frequency of the lift, f B / V (NaN: steady wake)")
+    write_dataset(g, "strouhal_on_depth", st.strouhal, "1", f"({n},) St = f D / V, D the section's depth")
+    write_dataset(g, "settling", st.settling, "1",
+                  f"({n}, 3) change of C_D, C_L, C_M from the third to the last quarter of the run (not settled "
+                  "if large)")
+    for name, values in (("drag", st.drag), ("lift", st.lift), ("moment", st.moment)):
+        at0, slope = st.fit(values)
+        write_dataset(g, f"fit/{name}_at_zero", at0, "1", f"C of {name} at alpha = 0 from the line fit")
+        write_dataset(g, f"fit/{name}_slope", slope, "1/rad", f"dC/dalpha of {name} from the line fit")
 
 
 def values_of(d: AeroResult) -> tuple[str, ...]:
@@ -174,11 +232,30 @@ def _report(d: AeroResult) -> str:
         for name in ("H1", "H3", "A1", "A2", "A3"):
             row += [f"{np.asarray(getattr(der, name))[i]:.3f}", f"{np.asarray(getattr(theo, name))[i]:.3f}"]
         lines.append("| " + " | ".join(row) + " |")
+    if d.static is not None:
+        lines += _static_report(d.static)
     lines += ["", "Cases: " + "; ".join(f"{r['dof']} K = {r['K']:.3f}: {r['steps']} steps, {r['periods']} periods "
                                        f"fitted, {r['wall_s']:.0f} s" + (f" (resumed at step {r['resumed_from_step']})"
                                                                          if r["resumed_from_step"] else "")
                                        for r in d.records) + "."]
     return "\n".join(lines) + "\n"
+
+
+def _static_report(st: StaticCoefficients) -> list[str]:
+    lines = ["", "Static coefficients (section held still; means over t V/B in "
+             f"[{st.window[0]:.1f}, {st.window[1]:.1f}]; on B, moment nose-up about the reference point):", "",
+             "| angle [deg] | C_D | C_L | C_M | lift rms | St = f D / V | settling (C_D, C_L, C_M) |",
+             "|---|---|---|---|---|---|---|"]
+    for i, a in enumerate(st.angles_deg):
+        stn = "steady" if math.isnan(st.strouhal[i]) else f"{st.strouhal[i]:.4f}"
+        lines.append(f"| {a:g} | {st.drag[i]:.4f} | {st.lift[i]:.4f} | {st.moment[i]:.4f} | {st.lift_rms[i]:.2e} "
+                     f"| {stn} | " + ", ".join(f"{x:+.1e}" for x in st.settling[i]) + " |")
+    (cd, dcd), (cl, dcl), (cm, dcm) = (st.fit(v) for v in (st.drag, st.lift, st.moment))
+    lines += ["", f"Line fits: C_D = {cd:.4f} + {dcd:.4f} alpha, C_L = {cl:.4f} + {dcl:.4f} alpha, "
+              f"C_M = {cm:.4f} + {dcm:.4f} alpha (alpha in rad; thin-plate theory: dC_L/dalpha = 2 pi = 6.283, "
+              "dC_M/dalpha = pi/2 = 1.571 about mid-chord).  With aerodynamics = \"cfd\" these give the flutter "
+              "model its lateral (drag, sway) terms, quasi-steady."]
+    return lines
 
 
 def _figures(d: AeroResult) -> dict[str, Any]:
@@ -220,4 +297,31 @@ def _figures(d: AeroResult) -> dict[str, Any]:
         ax.legend(fontsize=7, loc="upper left")
         ax.set_title(f"Forced {dof}, K = {r['K']:.3f} (U/(fB) = {2 * math.pi / r['K']:.2f})")
         figs[f"aero_{dof}_forces.png"] = fig
+    if d.static is not None:
+        figs["aero_static.png"] = _static_figure(d)
     return figs
+
+
+def _static_figure(d: AeroResult):
+    from matplotlib.figure import Figure
+
+    st = d.static
+    fig = Figure(figsize=(9.0, 3.6), layout="constrained")
+    ax, ax2 = fig.subplots(1, 2)
+    for values, label in ((st.drag, "C_D"), (st.lift, "C_L"), (st.moment, "C_M (nose-up)")):
+        ax.plot(st.angles_deg, values, "o-", ms=4, label=label)
+    ax.set_xlabel("angle of attack, nose-up [deg]")
+    ax.set_ylabel("coefficient on B [-]")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7)
+    ax.set_title("Static coefficients")
+    r = d.static_records[int(np.argmin(np.abs(st.angles_deg)))]
+    ax2.plot(r["t"], 2 * np.asarray(r["lift"]), lw=0.7, label="C_L")
+    ax2.plot(r["t"], 2 * np.asarray(r["drag"]), lw=0.7, label="C_D")
+    ax2.axvspan(*st.window, color="0.9", label="averaged")
+    ax2.set_xlabel("t V / B [-]")
+    ax2.set_ylabel("coefficient on B [-]")
+    ax2.legend(fontsize=7)
+    ax2.set_title(f"Held at {r['angle_deg']:g} deg from an impulsive start")
+    fig.suptitle(f"{d.section[:70]}, Re = {d.reynolds:g}", fontsize=9)
+    return fig

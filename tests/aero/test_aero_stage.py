@@ -83,12 +83,18 @@ def test_the_aero_stage_feeds_flutter_and_bridges_with_one_deck_share_it(tmp_pat
     for name in ("h_pu", "h_ptheta", "h_mu", "h_mtheta"):
         np.testing.assert_allclose(getattr(h, name), getattr(aero.frf, name), rtol=1e-10, atol=1e-12)
     assert out_a["flutter"].summary["flutter.aerodynamics"].startswith("cfd (rectangle, tiny")
+    # the static runs (default -2, 0, 2 degrees) give the flutter model its lateral terms, quasi-steady
+    assert aero.static.angles_deg.tolist() == [-2.0, 0.0, 2.0]
+    qs = aero.static.quasi_steady()
+    hr = aero.model.frf(aero.reduced_frequency, 50.0)
+    np.testing.assert_allclose(hr.h_qr, -2j * aero.reduced_frequency * qs.drag_coefficient, rtol=1e-12)
+    assert qs.drag_coefficient > 0.1 and out_a["aero"].summary["aero.static.drag_coefficient"] == qs.drag_coefficient
     # another bridge (other masses, other name) with the same deck: the aero result is the stored one
     out_b = run_stages(b, None, options)
     assert out_b["aero"].from_cache and not out_b["flutter"].from_cache
     np.testing.assert_array_equal(out_b["aero"].data.frf.h_pu, aero.frf.h_pu)
     # the cases left their checkpoints, so a re-run after a kill would resume
-    assert len(list((tmp_path / "cache" / "aero-runs").glob("*.h5"))) == 4
+    assert len(list((tmp_path / "cache" / "aero-runs").glob("*.h5"))) == 4 + 3   # and the three static runs
 
 
 def test_a_checkpoint_of_other_solver_code_is_not_resumed(monkeypatch):

@@ -1,0 +1,95 @@
+"""Static coefficients and the Strouhal number of a section held still (bridge/aero/static.py).
+
+Closed forms: the spectral peak of a known sine on uneven samples; a symmetric section's odd and even
+coefficients; thin-aerofoil theory's lift and moment slopes (2 pi and pi/2 about mid-chord; Glauert,
+*The elements of aerofoil and airscrew theory*, 1926) at a coarse grid with a loose tolerance.  Published
+data: the circular cylinder at Re = 100 (Williamson 1989, St = 0.164) in the slow set."""
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+from bridge.aero.forced_motion import QUALITY, ForceRecord, StaticCase, run_case
+from bridge.aero.options import AeroOptions
+from bridge.aero.stage import _unit_polygon
+from bridge.aero.static import shedding_frequency, static_coefficients, window_mean
+from bridge.cfd.sections import FlatPlate
+from bridge.errors import InputError
+
+
+def test_the_shedding_frequency_of_a_known_sine_on_uneven_steps():
+    rng = np.random.default_rng(3)
+    t = np.cumsum(rng.uniform(0.01, 0.03, 3000))           # about 60 time units, uneven
+    f0 = 0.2371
+    x = 0.3 + 0.01 * t + 0.05 * np.sin(2 * np.pi * f0 * t + 0.4) + 0.002 * rng.standard_normal(t.size)
+    f, rms = shedding_frequency(t, x)
+    assert f == pytest.approx(f0, rel=2e-3)
+    assert rms == pytest.approx(0.05 / math.sqrt(2), rel=0.05)
+    # a steady record (a constant and a drift only) has no shedding frequency
+    f, rms = shedding_frequency(t, 0.3 + 0.01 * t)
+    assert math.isnan(f) and rms < 1e-10
+    # a record of 1.5 periods cannot resolve its frequency
+    short = t[t < 1.5 / f0]
+    f, rms = shedding_frequency(short, np.sin(2 * np.pi * f0 * short))
+    assert math.isnan(f) and rms > 0.1
+
+
+def test_the_window_mean_weights_uneven_steps():
+    t = np.array([0.0, 0.1, 1.0, 1.1, 2.0])
+    x = 2.0 * t
+    assert window_mean(t, x, 0.0) == pytest.approx(2.0)   # mean of a line over [0, 2]
+    assert window_mean(t, x, 1.0, 2.0) == pytest.approx(3.0)
+
+
+def test_fits_give_the_line_through_the_angles():
+    angles = np.array([-2.0, 0.0, 2.0])
+    a = np.radians(angles)
+    recs = []
+    for alpha in a:
+        t = np.linspace(0.0, 10.0, 201)
+        one = np.ones_like(t)
+        recs.append(ForceRecord(t=t, lift=0.5 * (0.1 + 5.0 * alpha) * one, drag=0.5 * (0.2 + 0.3 * alpha) * one,
+                                moment=0.5 * (-0.01 + 1.2 * alpha) * one, motion=alpha * one))
+    st = static_coefficients(recs, angles, depth_over_chord=0.1)
+    assert st.fit(st.lift) == pytest.approx((0.1, 5.0))
+    qs = st.quasi_steady()
+    assert (qs.lift_coefficient, qs.lift_slope_per_rad) == pytest.approx((0.1, 5.0))
+    assert (qs.drag_coefficient, qs.drag_slope_per_rad) == pytest.approx((0.2, 0.3))
+    assert (qs.moment_coefficient, qs.moment_slope_per_rad) == pytest.approx((-0.01, 1.2))
+    assert np.all(np.isnan(st.strouhal)) and np.allclose(st.settling, 0.0)
+
+
+def test_static_angles_are_checked():
+    assert AeroOptions(static_angles_deg=()).static_angles_deg == ()
+    assert AeroOptions(static_angles_deg=(3, -1)).static_angles_deg == (-1.0, 3.0)
+    for bad, word in (((1.0,),  "at least 2"), ((0.0, 0.0), "distinct"), ((0.0, 45.0), "<= 30"),
+                      ("0, 2", "a list")):
+        with pytest.raises(InputError, match=word):
+            AeroOptions(static_angles_deg=bad)
+
+
+# a coarse but resolving grid for a 4 % plate: 24 cells per chord, dy = dx / 4 (the plate 4 cells thick)
+COARSE = dataclasses.replace(QUALITY["tiny"], name="coarse", cells_per_chord=24, dy_over_dx=0.25, upstream=1.0,
+                             downstream=4.0, half_height=1.5, core_half_height=0.1, reynolds=1000.0,
+                             static_duration=12.0)
+
+
+@pytest.mark.slow  # ~40 s (three static runs): runs in CI with -m slow
+def test_a_thin_plate_held_still_has_thin_aerofoil_slopes_and_symmetry():
+    """Plate 4 % thick at -2, 0, 2 degrees, Re 1000, 24 cells per chord, 12 chords of run: C_L odd and C_D
+    even in the angle (the grid is symmetric), dC_L/dalpha within 20 % of 2 pi (viscosity, the finite
+    wake, the short run and Wagner's lag all lower it) and the aerodynamic centre near the quarter chord:
+    dC_M/dalpha (about mid-chord) over dC_L/dalpha within 0.25 +- 0.05."""
+    poly = _unit_polygon(FlatPlate(1.0, 0.04))
+    angles = (-2.0, 0.0, 2.0)
+    recs = [run_case(poly, StaticCase(a, grid_angle_deg=2.0), COARSE) for a in angles]
+    st = static_coefficients(recs, angles, 0.04)
+    assert abs(st.lift[1]) < 1e-3 and abs(st.moment[1]) < 1e-4
+    assert st.lift[0] == pytest.approx(-st.lift[2], rel=1e-3)
+    assert st.drag[0] == pytest.approx(st.drag[2], rel=1e-3)
+    _, dcl = st.fit(st.lift)
+    _, dcm = st.fit(st.moment)
+    assert 0.8 * 2 * np.pi < dcl < 1.05 * 2 * np.pi, dcl
+    assert 0.20 < dcm / dcl < 0.30, (dcm, dcl)
