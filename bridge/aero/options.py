@@ -10,6 +10,10 @@ Keys (all optional):
                           0.4 / 50 = 0.008, thesis 5.3)
     pitch_rate            rotation-rate amplitude thetadot_0 B / V (default the thesis's 0.028 * 31 / 50)
     checkpoint_every      steps between checkpoints of a running case (default 2000)
+    excitation            "single": one heave and one pitch run per reduced velocity (default); "multi": one
+                          heave and one pitch run moving at all of them at once (a sum of sines,
+                          bridge.aero.forced_motion.ForcedCase.multi_frequency); the reduced velocities must
+                          then be the largest one over whole numbers (e.g. 16, 8, 5.333, 4)
     static_angles_deg     angles of attack (degrees, nose-up) at which the section is held still for its
                           static coefficients C_D, C_L, C_M, their slopes and the Strouhal number
                           (default -2, 0, 2; [] skips them); with aerodynamics = "cfd" they supply the
@@ -37,6 +41,7 @@ class AeroOptions:
     pitch_rate: float = 0.028 * 31.0 / 50.0
     checkpoint_every: int = 2000
     static_angles_deg: tuple[float, ...] = (-2.0, 0.0, 2.0)
+    excitation: str = "single"
 
     def __post_init__(self):
         from bridge.aero.forced_motion import QUALITY
@@ -50,6 +55,18 @@ class AeroOptions:
         if len(set(rv)) != len(rv):
             raise InputError("aero.reduced_velocities", values, "distinct values")
         object.__setattr__(self, "reduced_velocities", rv)
+        if self.excitation not in ("single", "multi"):
+            raise InputError("aero.excitation", self.excitation, "one of single, multi")
+        if self.excitation == "multi":
+            top = rv[-1]
+            ratios = [top / v for v in rv]
+            if any(abs(r - round(r)) > 1e-3 * r for r in ratios):
+                raise InputError("aero.reduced_velocities", values,
+                                 f"with excitation = \"multi\": the largest ({top:g}) over whole numbers, e.g. "
+                                 + ", ".join(f"{top / m:.4g}" for m in range(1, 5)))
+            # the frequencies are taken as exact multiples of the lowest (the whole periods need it)
+            rv = tuple(top / round(top / v) for v in rv)
+            object.__setattr__(self, "reduced_velocities", rv)
         check_range("aero.heave_rate", self.heave_rate, 0.0, 0.2, low_open=True)
         check_range("aero.pitch_rate", self.pitch_rate, 0.0, 0.2, low_open=True)
         if isinstance(self.checkpoint_every, bool) or not isinstance(self.checkpoint_every, int) \

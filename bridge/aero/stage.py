@@ -95,26 +95,28 @@ def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
     values = {n: np.zeros(len(Ks), dtype=complex) for n in VERTICAL_TORSIONAL + ("h_qu", "h_qtheta")}
     errors = {n: np.zeros(len(Ks), dtype=complex) for n in values}
     records, cells = [], (0, 0)
-    n_cases = 2 * len(Ks)
-    for i, K in enumerate(Ks):
-        for dof, rate in (("heave", aopts.heave_rate), ("pitch", aopts.pitch_rate)):
-            case = ForcedCase(dof, (float(K),), (rate / float(K),))
-            label = f"aero case {len(records) + 1}/{n_cases}, {dof} U/(fB) = {2 * np.pi / K:.3g}"
-            checkpoint = None if runs is None else runs / f"{case_key(poly, case, q)[:24]}.h5"
-            rec = run_case(poly, case, q, checkpoint, aopts.checkpoint_every, progress=options.say, label=label)
-            sel = whole_periods(rec, case, q.discard_periods)
-            (resp,) = forced_motion_response(rec.t[sel], rec.motion[sel], [float(K)], dof=dof, speed_m_s=1.0,
-                                             deck_width_m=1.0, air_density_kg_m3=1.0, lift=rec.lift[sel],
-                                             moment=rec.moment[sel], drag=rec.drag[sel], fundamental=float(K))
+    cases = _forced_cases(Ks, aopts)
+    for n, case in enumerate(cases):
+        ks = case.reduced_frequencies
+        what = ", ".join(f"{2 * np.pi / k:.3g}" for k in ks)
+        label = f"aero case {n + 1}/{len(cases)}, {case.dof} U/(fB) = {what}"
+        checkpoint = None if runs is None else runs / f"{case_key(poly, case, q)[:24]}.h5"
+        rec = run_case(poly, case, q, checkpoint, aopts.checkpoint_every, progress=options.say, label=label)
+        sel = whole_periods(rec, case, q)
+        responses = forced_motion_response(rec.t[sel], rec.motion[sel], list(ks), dof=case.dof, speed_m_s=1.0,
+                                           deck_width_m=1.0, air_density_kg_m3=1.0, lift=rec.lift[sel],
+                                           moment=rec.moment[sel], drag=rec.drag[sel], fundamental=case.fundamental)
+        for k, resp in zip(ks, responses, strict=True):
+            i = int(np.argmin(np.abs(Ks - k)))
             for name in resp.provides:
                 if name in values:
                     values[name][i] = getattr(resp.frf, name)
                     errors[name][i] = getattr(resp.stderr, name)
-            cells = (rec.meta["nx"], rec.meta["ny"])
-            records.append({"dof": dof, "K": float(K), "steps": rec.steps, "wall_s": rec.wall_s,
-                            "resumed_from_step": rec.resumed_from_step, "periods": resp.periods,
-                            "t": rec.t, "lift": rec.lift, "moment": rec.moment, "motion": rec.motion,
-                            "window": (float(rec.t[sel][0]), float(rec.t[sel][-1]))})
+        cells = (rec.meta["nx"], rec.meta["ny"])
+        records.append({"dof": case.dof, "K": case.fundamental, "Ks": list(ks), "steps": rec.steps,
+                        "wall_s": rec.wall_s, "resumed_from_step": rec.resumed_from_step,
+                        "periods": responses[0].periods, "t": rec.t, "lift": rec.lift, "moment": rec.moment,
+                        "motion": rec.motion, "window": (float(rec.t[sel][0]), float(rec.t[sel][-1]))})
     static, static_records = _static_runs(poly, section, aopts, q, runs, options)
     frf, stderr = FRF(**values), FRF(**errors)
     table = DerivativeTable(Ks, derivatives_from_frf(Ks, frf), source=f"cfd ({section.name}, {quality})",
@@ -125,6 +127,15 @@ def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
                       warning, static, tuple(static_records))
     return StageOutput(summary=_summary(data), write_h5=lambda g: _write_h5(g, data), report=_report(data),
                        figures=_figures(data), data=data)
+
+
+def _forced_cases(Ks: np.ndarray, aopts: AeroOptions) -> list[ForcedCase]:
+    """The heave and pitch runs: one per reduced frequency (``excitation = "single"``), or one per degree of
+    freedom moving at all of them at once (``"multi"``, :meth:`ForcedCase.multi_frequency`)."""
+    rates = (("heave", aopts.heave_rate), ("pitch", aopts.pitch_rate))
+    if aopts.excitation == "multi":
+        return [ForcedCase.multi_frequency(dof, tuple(float(k) for k in Ks), rate) for dof, rate in rates]
+    return [ForcedCase(dof, (float(K),), (rate / float(K),)) for K in Ks for dof, rate in rates]
 
 
 def _static_runs(poly, section, aopts: AeroOptions, q, runs, options: RunOptions):
@@ -234,7 +245,7 @@ def _report(d: AeroResult) -> str:
         lines.append("| " + " | ".join(row) + " |")
     if d.static is not None:
         lines += _static_report(d.static)
-    lines += ["", "Cases: " + "; ".join(f"{r['dof']} K = {r['K']:.3f}: {r['steps']} steps, {r['periods']} periods "
+    lines += ["", "Cases: " + "; ".join(f"{r['dof']} K = {', '.join(f'{k:.3f}' for k in r['Ks'])}: {r['steps']} steps, {r['periods']} periods "
                                        f"fitted, {r['wall_s']:.0f} s" + (f" (resumed at step {r['resumed_from_step']})"
                                                                          if r["resumed_from_step"] else "")
                                        for r in d.records) + "."]
@@ -295,7 +306,9 @@ def _figures(d: AeroResult) -> dict[str, Any]:
         ax2.plot(r["t"], r["motion"], "k--", lw=0.6)
         ax2.set_ylabel(f"{dof} ({'up' if dof == 'heave' else 'nose-up'}) [{unit}], dashed")
         ax.legend(fontsize=7, loc="upper left")
-        ax.set_title(f"Forced {dof}, K = {r['K']:.3f} (U/(fB) = {2 * math.pi / r['K']:.2f})")
+        ks = ", ".join(f"{k:.3f}" for k in r["Ks"])
+        uvs = ", ".join(f"{2 * math.pi / k:.2f}" for k in r["Ks"])
+        ax.set_title(f"Forced {dof}, K = {ks} (U/(fB) = {uvs})")
         figs[f"aero_{dof}_forces.png"] = fig
     if d.static is not None:
         figs["aero_static.png"] = _static_figure(d)
