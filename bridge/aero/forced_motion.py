@@ -372,4 +372,10 @@ def whole_periods(record: ForceRecord, case: ForcedCase, q: Quality) -> np.ndarr
     drops, ending on the last whole period."""
     T = 2 * math.pi / case.fundamental
     n_whole = int(math.floor(record.t[-1] / T + 1e-9))
-    return (record.t > case.discarded_periods(q) * T) & (record.t <= n_whole * T + 1e-12)
+    t = record.t
+    # from the last sample at or before the start (a window starting after it is shorter than its periods and
+    # would lose one of them), to the last sample at or before the end of the last whole period
+    first = max(int(np.searchsorted(t, case.discarded_periods(q) * T * (1 + 1e-12), side="right")) - 1, 0)
+    mask = t <= n_whole * T * (1 + 1e-12)
+    mask[:first] = False
+    return mask

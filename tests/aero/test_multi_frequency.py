@@ -16,7 +16,7 @@ from bridge.errors import InputError
 # 4 % plate, 24 cells per chord, dy = dx / 4 (4 cells thick), 4 chords of wake: coarse, but a resolved body
 COARSE = dataclasses.replace(QUALITY["tiny"], name="coarse", cells_per_chord=24, dy_over_dx=0.25, upstream=1.0,
                              downstream=4.0, half_height=1.5, core_half_height=0.1, reynolds=1000.0, periods=4,
-                             discard_periods=2)
+                             discard_periods=2, settle_time=16.0)
 
 
 def _frfs(case, q):
