@@ -167,8 +167,9 @@ class ForcedCase:
     def discarded_periods(self, q: Quality) -> int:
         """Periods of the fundamental dropped before the fit: ``q.discard_periods``, or more if they last less
         than ``q.settle_time``.  The start-up decays in convective time (the shed vorticity of the first
-        periods has to travel away), not in periods: a thin plate at U/(fB) = 4 fitted after 2 periods
-        (8 B / V) had Re h_ptheta 16 % below the value fitted after 4 or 8 periods (docs/aero.md)."""
+        periods has to travel away), not in periods, so at high K two periods are a short wait; it also
+        gives single runs the wait of a multi-frequency run (two periods of its lowest frequency).  A margin,
+        not a measured need: on a short grid the periods after 8 B/V already agreed to 0.1 % (docs/aero.md)."""
         T = 2 * math.pi / self.fundamental
         return max(q.discard_periods, math.ceil(q.settle_time / T - 1e-9))
 
