@@ -112,11 +112,13 @@ def main(argv=None) -> int:
                                       say=lambda m: print(m, file=sys.stderr, flush=True))
         print("\n| U/(fB) | FRF | multi-frequency | single | difference |\n|---|---|---|---|---|")
         for uv, name, m, s1, d, _ in multi:
-            print(f"| {uv:g} | {name} | {m.real:.3f} {m.imag:+.3f}i | {s1.real:.3f} {s1.imag:+.3f}i | {100 * d:.1f} % |")
+            print(f"| {uv:g} | {name} | {m.real:.3f} {m.imag:+.3f}i | {s1.real:.3f} {s1.imag:+.3f}i "
+                  f"| {100 * d:.1f} % |")
         print(f"multi-frequency runs: {sum({r[5] for r in multi}):.0f} s; single runs: "
               f"{sum(r['wall_s'] for r in rows):.0f} s")
         for r in rows:
-            r["multi"] = {name: [m.real, m.imag] for uv, name, m, _, _, _ in multi if abs(uv - r["reduced_velocity"]) < 1e-6}
+            r["multi"] = {name: [m.real, m.imag] for uv, name, m, _, _, _ in multi
+                          if abs(uv - r["reduced_velocity"]) < 1e-6}
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(json.dumps(rows, indent=2))
     return 0

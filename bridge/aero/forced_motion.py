@@ -307,8 +307,8 @@ def run_case(shape, case: ForcedCase | StaticCase, quality: Quality, checkpoint:
              checkpoint_every: int = 2000, threads: int | None = None,
              progress: Callable[[str], None] | None = None, label: str = "") -> ForceRecord:
     """Run one case - forced motion for :meth:`ForcedCase.end_time` (the caller drops the first
-    :meth:`ForcedCase.discarded_periods`, :func:`whole_periods`), or a section held still for ``quality.static_duration`` - and return the
-    whole force record.  ``shape``: the section's polygon,
+    :meth:`ForcedCase.discarded_periods`, :func:`whole_periods`), or a section held still for
+    ``quality.static_duration`` - and return the whole force record.  ``shape``: the section's polygon,
     or a list of polygons moving together (a box with railings); the loads are their sum.  Resumes from
     ``checkpoint`` if it holds this case (:func:`case_key`); progress lines about every 10 % of the run.
     ``threads``: CPU threads of the step (default 2, but 1 below 20 000 cells, where waiting for the second thread

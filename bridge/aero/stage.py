@@ -245,11 +245,15 @@ def _report(d: AeroResult) -> str:
         lines.append("| " + " | ".join(row) + " |")
     if d.static is not None:
         lines += _static_report(d.static)
-    lines += ["", "Cases: " + "; ".join(f"{r['dof']} K = {', '.join(f'{k:.3f}' for k in r['Ks'])}: {r['steps']} steps, {r['periods']} periods "
+    lines += ["", "Cases: " + "; ".join(f"{r['dof']} K = {_ks(r)}: {r['steps']} steps, {r['periods']} periods "
                                        f"fitted, {r['wall_s']:.0f} s" + (f" (resumed at step {r['resumed_from_step']})"
                                                                          if r["resumed_from_step"] else "")
                                        for r in d.records) + "."]
     return "\n".join(lines) + "\n"
+
+
+def _ks(record: dict) -> str:
+    return ", ".join(f"{k:.3f}" for k in record["Ks"])
 
 
 def _static_report(st: StaticCoefficients) -> list[str]:
@@ -306,7 +310,7 @@ def _figures(d: AeroResult) -> dict[str, Any]:
         ax2.plot(r["t"], r["motion"], "k--", lw=0.6)
         ax2.set_ylabel(f"{dof} ({'up' if dof == 'heave' else 'nose-up'}) [{unit}], dashed")
         ax.legend(fontsize=7, loc="upper left")
-        ks = ", ".join(f"{k:.3f}" for k in r["Ks"])
+        ks = _ks(r)
         uvs = ", ".join(f"{2 * math.pi / k:.2f}" for k in r["Ks"])
         ax.set_title(f"Forced {dof}, K = {ks} (U/(fB) = {uvs})")
         figs[f"aero_{dof}_forces.png"] = fig
