@@ -6,7 +6,9 @@ Runs one heave and one pitch case per reduced velocity with the aero stage's run
 thesis velocity amplitudes, transient periods dropped, harmonic fit over whole periods) and prints the
 eight derivatives H1*-H4*, A1*-A4* (B form, h and L down) beside Theodorsen's (Theodorsen 1935, NACA
 Report 496; check values in docs/reference_cases.md) with the relative differences; writes the numbers
-to ``--out`` (JSON).  Cases run one after another on both cores; each takes minutes on the standard grid.
+to ``--out`` (JSON); each case keeps its checkpoint (with its force record) in ``validate_aero_runs/`` beside
+it, so an interrupted validation resumes and a finished case is read back instead of run again.  Cases run
+one after another on both cores; each takes minutes on the standard grid.
 """
 
 from __future__ import annotations
@@ -26,10 +28,12 @@ from bridge.aero.forced_motion import (  # noqa: E402
     THESIS_HEAVE_RATE,
     THESIS_PITCH_RATE,
     ForcedCase,
+    case_key,
     run_case,
     whole_periods,
 )
 from bridge.aero.frequency_response import forced_motion_response  # noqa: E402
+from bridge.aero.options import AeroOptions  # noqa: E402
 from bridge.aero.stage import _unit_polygon  # noqa: E402
 from bridge.cfd.sections import FlatPlate  # noqa: E402
 from bridge.flutter.aerodynamics import Theodorsen  # noqa: E402
@@ -38,33 +42,43 @@ from bridge.flutter.derivatives import FRF, derivatives_from_frf  # noqa: E402
 NAMES = ("H1", "H2", "H3", "H4", "A1", "A2", "A3", "A4")
 
 
-def plate_derivatives(reduced_velocity: float, quality: str, thickness: float, say=print) -> dict:
+def _checkpoint(runs: Path | None, poly, case, q) -> Path | None:
+    """Where a case keeps its checkpoint (and so its record): a killed run resumes, a finished one is read back."""
+    return None if runs is None else runs / f"{case_key(poly, case, q)[:24]}.h5"
+
+
+def plate_derivatives(reduced_velocity: float, quality: str, thickness: float, say=print,
+                      runs: Path | None = None) -> dict:
     poly = _unit_polygon(FlatPlate(1.0, thickness))
     q = QUALITY[quality]
     K = 2 * np.pi / reduced_velocity
     h, wall = {}, 0.0
     for dof in ("heave", "pitch"):
         case = ForcedCase.thesis(dof, K)
-        rec = run_case(poly, case, q, progress=say, label=f"U/(fB) = {reduced_velocity:g} {dof}")
+        rec = run_case(poly, case, q, _checkpoint(runs, poly, case, q), progress=say,
+                       label=f"U/(fB) = {reduced_velocity:g} {dof}")
         wall += rec.wall_s
         sel = whole_periods(rec, case, q)
         (resp,) = forced_motion_response(rec.t[sel], rec.motion[sel], [K], dof=dof, speed_m_s=1.0, deck_width_m=1.0,
                                          air_density_kg_m3=1.0, lift=rec.lift[sel], moment=rec.moment[sel],
                                          fundamental=K)
         h.update({n: complex(getattr(resp.frf, n)) for n in resp.provides})
+        periods = resp.periods
         cells = (rec.meta["nx"], rec.meta["ny"])
     frf = FRF(h_pu=h["h_pu"], h_ptheta=h["h_ptheta"], h_mu=h["h_mu"], h_mtheta=h["h_mtheta"])
     cfd = derivatives_from_frf(np.array([K]), FRF(*(np.array([v]) for v in frf[:4])))
     ref = derivatives_from_frf(np.array([K]), Theodorsen().frf(np.array([K]), 1.0))
     row = {"reduced_velocity": reduced_velocity, "K": K, "quality": quality, "thickness": thickness,
-           "cells": cells, "wall_s": wall, "frf": {k: [v.real, v.imag] for k, v in h.items()}}
+           "cells": cells, "wall_s": wall, "periods_fitted": periods,
+           "frf": {k: [v.real, v.imag] for k, v in h.items()}}
     for n in NAMES:
         c, r = float(np.asarray(getattr(cfd, n))[0]), float(np.asarray(getattr(ref, n))[0])
         row[n] = {"cfd": c, "theodorsen": r, "relative_difference": (c - r) / abs(r)}
     return row
 
 
-def multi_frequency_check(reduced_velocities, quality: str, thickness: float, singles: list[dict], say=print) -> list:
+def multi_frequency_check(reduced_velocities, quality: str, thickness: float, singles: list[dict], say=print,
+                          runs: Path | None = None) -> list:
     """One heave and one pitch run at all the reduced velocities at once (ForcedCase.multi_frequency, each
     sine at the single run's amplitude) against the single runs ``singles``: rows of
     (U/(fB), name, multi, single, |multi - single| / |single|)."""
@@ -74,7 +88,7 @@ def multi_frequency_check(reduced_velocities, quality: str, thickness: float, si
     rows = []
     for dof, rate in (("heave", THESIS_HEAVE_RATE), ("pitch", THESIS_PITCH_RATE)):
         case = ForcedCase.multi_frequency(dof, Ks, rate)
-        rec = run_case(poly, case, q, progress=say, label=f"multi-frequency {dof}")
+        rec = run_case(poly, case, q, _checkpoint(runs, poly, case, q), progress=say, label=f"multi-frequency {dof}")
         sel = whole_periods(rec, case, q)
         out = forced_motion_response(rec.t[sel], rec.motion[sel], list(Ks), dof=dof, speed_m_s=1.0, deck_width_m=1.0,
                                      air_density_kg_m3=1.0, lift=rec.lift[sel], moment=rec.moment[sel],
@@ -98,8 +112,12 @@ def main(argv=None) -> int:
     ap.add_argument("--out", type=Path, default=Path("out/validate_aero.json"))
     args = ap.parse_args(argv)
     t0 = time.perf_counter()
-    rows = [plate_derivatives(uv, args.quality, args.thickness, say=lambda m: print(m, file=sys.stderr, flush=True))
-            for uv in args.reduced_velocities]
+    if args.multi:   # checked before the single runs: the multi run needs U_max / m
+        AeroOptions(excitation="multi", reduced_velocities=tuple(args.reduced_velocities))
+    runs = args.out.parent / "validate_aero_runs"
+    runs.mkdir(parents=True, exist_ok=True)
+    say = lambda m: print(m, file=sys.stderr, flush=True)  # noqa: E731
+    rows = [plate_derivatives(uv, args.quality, args.thickness, say=say, runs=runs) for uv in args.reduced_velocities]
     print(f"thin plate t/B = {args.thickness:g}, preset {args.quality!r}, {time.perf_counter() - t0:.0f} s")
     print("| U/(fB) | " + " | ".join(f"{n}* CFD / Theodorsen (diff)" for n in NAMES) + " |")
     print("|---|" + "---|" * len(NAMES))
@@ -108,8 +126,8 @@ def main(argv=None) -> int:
                  for n in NAMES]
         print(f"| {r['reduced_velocity']:g} | " + " | ".join(cells) + " |")
     if args.multi:
-        multi = multi_frequency_check(args.reduced_velocities, args.quality, args.thickness, rows,
-                                      say=lambda m: print(m, file=sys.stderr, flush=True))
+        rv = AeroOptions(excitation="multi", reduced_velocities=tuple(args.reduced_velocities)).reduced_velocities
+        multi = multi_frequency_check(rv, args.quality, args.thickness, rows, say=say, runs=runs)
         print("\n| U/(fB) | FRF | multi-frequency | single | difference |\n|---|---|---|---|---|")
         for uv, name, m, s1, d, _ in multi:
             print(f"| {uv:g} | {name} | {m.real:.3f} {m.imag:+.3f}i | {s1.real:.3f} {s1.imag:+.3f}i "

@@ -374,9 +374,11 @@ def whole_periods(record: ForceRecord, case: ForcedCase, q: Quality) -> np.ndarr
     T = 2 * math.pi / case.fundamental
     n_whole = int(math.floor(record.t[-1] / T + 1e-9))
     t = record.t
-    # from the last sample at or before the start (a window starting after it is shorter than its periods and
-    # would lose one of them), to the last sample at or before the end of the last whole period
+    # from the last sample at or before the start to the first at or after the end of the last whole period:
+    # a window that starts after the first period's start or ends before its last one's end is shorter than
+    # its periods, and the fit (periods ending at its last sample) would lose one of them
     first = max(int(np.searchsorted(t, case.discarded_periods(q) * T * (1 + 1e-12), side="right")) - 1, 0)
-    mask = t <= n_whole * T * (1 + 1e-12)
-    mask[:first] = False
+    last = min(int(np.searchsorted(t, n_whole * T * (1 - 1e-12), side="left")), t.size - 1)
+    mask = np.zeros(t.size, dtype=bool)
+    mask[first:last + 1] = True
     return mask

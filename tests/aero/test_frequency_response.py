@@ -87,19 +87,21 @@ def test_the_drift_does_not_amplify_noise_on_short_windows():
 
 
 def test_the_forced_motion_window_holds_every_period_after_the_discarded_ones():
-    """Regression: the mask started after the first sample of the window, so the fit lost a period (the
-    standard preset fitted 1 of its 2 periods)."""
+    """Regression: the mask started after the first sample of the window and ended before the run's last
+    one, so the fit often lost a period (the standard preset fitted 1 of its 2).  Records end as run_case
+    ends them: at the first step at or past the end time; 100 of them with random uneven steps."""
     from bridge.aero.forced_motion import QUALITY, ForcedCase, ForceRecord, whole_periods
 
-    case = ForcedCase.thesis("pitch", 0.785)
-    q = QUALITY["standard"]
-    T = 2 * np.pi / 0.785
-    t = np.cumsum(np.random.default_rng(0).uniform(0.005, 0.015, 4000))
-    t = t[t <= 4 * T + 0.01]
-    rec = ForceRecord(t=t, lift=np.sin(0.785 * t), drag=0 * t, moment=0 * t, motion=np.sin(0.785 * t))
-    sel = whole_periods(rec, case, q)
-    assert case.discarded_periods(q) == 2
-    assert harmonic_fit(t[sel], rec.lift[sel], 0.785).periods == 2
+    for name in ("standard", "tiny"):
+        q = QUALITY[name]
+        case = ForcedCase.thesis("pitch", 0.785)
+        fitted = q.periods - q.discard_periods
+        for seed in range(100):
+            t = np.cumsum(np.random.default_rng(seed).uniform(0.005, 0.015, 8000))
+            t = t[: int(np.searchsorted(t, case.end_time(q))) + 1]
+            rec = ForceRecord(t=t, lift=np.sin(0.785 * t), drag=0 * t, moment=0 * t, motion=np.sin(0.785 * t))
+            sel = whole_periods(rec, case, q)
+            assert harmonic_fit(t[sel], rec.lift[sel], 0.785).periods == fitted, (name, seed)
 
 
 def test_reported_standard_error_matches_the_scatter_over_200_seeds():
