@@ -10,7 +10,11 @@ normalised FRFs h_xy of Eq 4.37 depending on Omega alone, H_pudot = h_pu (rho V^
 at fixed Omega, so the two columns should differ by a factor 2 in every amplitude and not at all in the
 phases; the thesis's amplitudes differ by 3-9 %.  This tool prints, for both speeds, the thesis's values,
 Theodorsen's (flat plate, mid-chord axis) and, given a results.h5 with an ``/aero`` group, the CFD's (the
-stage's derivative table at Omega = 0.496), and the normalised |h_xy| each implies.
+stage's derivative table at Omega = 0.496), and the normalised |h_xy| each implies.  The phases are printed
+twice: phi of the rate FRF (what Eq 5.12 defines) and phi of H_x = i w H_xdot, the phase against the
+displacement (Eq 5.8: phi_x = phi_xdot - pi/2).  The thesis's V = 25 m/s phases lie within 0.2 rad of
+Theodorsen's displacement phases and about pi/2 from its rate phases: the thesis seems to have measured them
+against the displacement.
 """
 
 from __future__ import annotations
@@ -72,18 +76,19 @@ def main(argv=None) -> int:
             print(f"the CFD table covers Omega {krange[0]:.3f}-{krange[1]:.3f}, not {omega:.3f}", file=sys.stderr)
             return 2
         models.append((model, label))
-    print("| FRF | source | V [m/s], w [rad/s] | abs(H_xdot) | phi [rad] | abs(h_xy) normalised (Eq 4.37) |")
-    print("|---|---|---|---|---|---|")
+    print("| FRF | source | V [m/s], w [rad/s] | abs(H_xdot) | phi [rad] | phi of H_x (to the displacement) [rad] "
+          "| abs(h_xy) normalised (Eq 4.37) |")
+    print("|---|---|---|---|---|---|---|")
     for name, (amps, phases) in THESIS.items():
         for (V, w), a, ph in zip(CASES, amps, phases, strict=True):
             h = normalised(a, ph, name, V, w)
-            print(f"| {name} | thesis Table 5.3 | {V:g}, {w:g} | {a:.3g} {UNIT[name]} | {ph:+.3f} | {abs(h):.3f} |")
+            print(f"| {name} | thesis Table 5.3 | {V:g}, {w:g} | {a:.3g} {UNIT[name]} | {ph:+.3f} | | {abs(h):.3f} |")
         for model, label in models:
             for V, w in CASES:
                 h = complex(np.asarray(getattr(model.frf(np.array([w * B / V]), V), name)).ravel()[0])
                 H = rate_frf(h, name, V, w)
                 print(f"| {name} | {label} | {V:g}, {w:g} | {abs(H):.3g} {UNIT[name]} | {-np.angle(H):+.3f} "
-                      f"| {abs(h):.3f} |")
+                      f"| {-np.angle(H * 1j * w):+.3f} | {abs(h):.3f} |")
     return 0
 
 

@@ -127,10 +127,12 @@ class ForcedCase:
         depends on how many cells the body travels (docs/aero.md, amplitude study), so a sine of a smaller
         amplitude would not measure the same thing as its single run.  The displacement then peaks at no more
         than sum(1/m) times the lowest sine's (2.08 for four harmonics), still a small motion; Schroeder's
-        phases (phi_m = -pi m (m - 1) / M, IEEE Trans. Inf. Theory 16, 1970) keep the sines from peaking
-        together."""
-        m = len(Ks)
-        phases = tuple(-math.pi * j * (j - 1) / m for j in range(1, m + 1))
+        phases (phi_m = -pi m (m - 1) / M for harmonic m of M, IEEE Trans. Inf. Theory 16, 1970) keep the
+        sines from peaking together."""
+        k0 = min(Ks)
+        harmonic = [round(k / k0) for k in Ks]       # the sine's harmonic number m of the lowest frequency
+        m_max = max(harmonic)
+        phases = tuple(-math.pi * m * (m - 1) / m_max for m in harmonic)
         return cls(dof, Ks, tuple(rate / k for k in Ks), phases)
 
     @property

@@ -152,7 +152,7 @@ class HarmonicFit:
     ``stderr`` (K,) complex: its real (imaginary) part is the standard error of Re X_k (Im X_k), from
     the scatter of ``per_period`` (n, K), the fits of each whole period (NaN when n = 1);
     ``periods`` n, ``period`` T_0 = 2 pi / w_0, ``window`` (t_start, t_end) = n whole periods;
-    ``mean`` c_0 and ``drift_rate`` c_1 (signal units per time unit, 0 without ``drift``);
+    ``mean`` c_0 and ``drift_rate`` c_1 (signal units per time unit; 0 without ``drift`` or with one period);
     ``residual_rms`` of the signal about the fitted model over the window.
     """
 

@@ -66,6 +66,9 @@ class AeroOptions:
                                  + ", ".join(f"{top / m:.4g}" for m in range(1, 5)))
             # the frequencies are taken as exact multiples of the lowest (the whole periods need it)
             rv = tuple(top / round(top / v) for v in rv)
+            if len(set(rv)) != len(rv):
+                raise InputError("aero.reduced_velocities", values, "distinct values after rounding to the "
+                                 f"largest ({top:g}) over whole numbers")
             object.__setattr__(self, "reduced_velocities", rv)
         check_range("aero.heave_rate", self.heave_rate, 0.0, 0.2, low_open=True)
         check_range("aero.pitch_rate", self.pitch_rate, 0.0, 0.2, low_open=True)

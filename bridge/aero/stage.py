@@ -9,7 +9,9 @@ the whole periods left (:func:`bridge.aero.frequency_response.forced_motion_resp
 
 The result is non-dimensional (CFD units B = V = rho = 1) and, with one Reynolds number per preset,
 independent of the wind speed: ``data.model`` is a :class:`bridge.flutter.tables.DerivativeTable` over
-the reduced frequencies run, which the flutter stage uses with ``[flutter] aerodynamics = "cfd"``.
+the reduced frequencies run - completed, when the section was also held still (``static_angles_deg``), by
+the quasi-steady lateral terms of its static coefficients (:class:`bridge.flutter.aerodynamics.WithLateral`)
+- which the flutter stage uses with ``[flutter] aerodynamics = "cfd"``.
 Cases are checkpointed under ``<cache>/aero-runs/`` (a killed run resumes); the stage result itself is
 cached like every stage's and shared by bridges with the same deck (``Stage.shared``).
 """
@@ -25,7 +27,7 @@ import numpy as np
 from bridge.aero.forced_motion import QUALITY, ForcedCase, StaticCase, case_key, run_case, whole_periods
 from bridge.aero.frequency_response import forced_motion_response
 from bridge.aero.options import AeroOptions
-from bridge.aero.static import StaticCoefficients, static_coefficients
+from bridge.aero.static import SHEDDING_THRESHOLD, StaticCoefficients, static_coefficients
 from bridge.flutter.aerodynamics import WithLateral
 from bridge.flutter.derivatives import DERIVATIVE_NAMES, FRF, VERTICAL_TORSIONAL, derivatives_from_frf
 from bridge.flutter.tables import DerivativeTable
@@ -103,9 +105,12 @@ def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
         checkpoint = None if runs is None else runs / f"{case_key(poly, case, q)[:24]}.h5"
         rec = run_case(poly, case, q, checkpoint, aopts.checkpoint_every, progress=options.say, label=label)
         sel = whole_periods(rec, case, q)
+        # a multi-frequency run's drag is no FRF: drag is quadratic in the motion, and twice one frequency is
+        # another of the set (h_qu, h_qtheta then come from the static runs' quasi-steady model)
+        drag = rec.drag[sel] if len(ks) == 1 else None
         responses = forced_motion_response(rec.t[sel], rec.motion[sel], list(ks), dof=case.dof, speed_m_s=1.0,
                                            deck_width_m=1.0, air_density_kg_m3=1.0, lift=rec.lift[sel],
-                                           moment=rec.moment[sel], drag=rec.drag[sel], fundamental=case.fundamental)
+                                           moment=rec.moment[sel], drag=drag, fundamental=case.fundamental)
         for k, resp in zip(ks, responses, strict=True):
             i = int(np.argmin(np.abs(Ks - k)))
             for name in resp.provides:
@@ -119,8 +124,9 @@ def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
                         "motion": rec.motion, "window": (float(rec.t[sel][0]), float(rec.t[sel][-1]))})
     static, static_records = _static_runs(poly, section, aopts, q, runs, options)
     frf, stderr = FRF(**values), FRF(**errors)
+    measured = VERTICAL_TORSIONAL + (("h_qu", "h_qtheta") if aopts.excitation == "single" else ())
     table = DerivativeTable(Ks, derivatives_from_frf(Ks, frf), source=f"cfd ({section.name}, {quality})",
-                            provides=VERTICAL_TORSIONAL + ("h_qu", "h_qtheta"))
+                            provides=measured)
     table.name = f"cfd ({section.name}, {quality}, Re {q.reynolds:g})"
     model = table if static is None else WithLateral(table, static.quasi_steady())
     data = AeroResult(section.describe(), quality, q.reynolds, cells, Ks, frf, stderr, model, tuple(records),
@@ -153,7 +159,12 @@ def _static_runs(poly, section, aopts: AeroOptions, q, runs, options: RunOptions
         records.append({"angle_deg": angle, "steps": rec.steps, "wall_s": rec.wall_s,
                         "resumed_from_step": rec.resumed_from_step, "t": rec.t, "lift": rec.lift,
                         "drag": rec.drag, "moment": rec.moment})
-    return static_coefficients(recs, angles, section.depth_m / section.chord_m), records
+    st = static_coefficients(recs, angles, section.depth_m / section.chord_m)
+    cd0 = st.fit(st.drag)[0]
+    if cd0 < 0.0:
+        options.say(f"aero: WARNING the static runs give a negative drag coefficient ({cd0:.4g}) at 0 degrees: "
+                    "the quasi-steady lateral terms use 0; the runs are not to be trusted (a finer preset?)")
+    return st, records
 
 
 def _summary(d: AeroResult) -> dict[str, Any]:
@@ -209,7 +220,8 @@ def _write_static_h5(g: Any, st: StaticCoefficients) -> None:
                                ("lift_rms", st.lift_rms, "rms of the lift coefficient's fluctuation")):
         write_dataset(g, name, values, "1", f"({n},) {what}, mean over the second half of the run")
     write_dataset(g, "shedding_frequency", st.frequency, "1",
-                  f"({n},) dominant frequency of the lift, f B / V (NaN: steady wake)")
+                  f"({n},) dominant frequency of the lift, f B / V (NaN: steady wake, or fewer than 2 periods in "
+                  "the window)")
     write_dataset(g, "strouhal_on_depth", st.strouhal, "1", f"({n},) St = f D / V, D the section's depth")
     write_dataset(g, "settling", st.settling, "1",
                   f"({n}, 3) change of C_D, C_L, C_M from the third to the last quarter of the run (not settled "
@@ -262,7 +274,8 @@ def _static_report(st: StaticCoefficients) -> list[str]:
              "| angle [deg] | C_D | C_L | C_M | lift rms | St = f D / V | settling (C_D, C_L, C_M) |",
              "|---|---|---|---|---|---|---|"]
     for i, a in enumerate(st.angles_deg):
-        stn = "steady" if math.isnan(st.strouhal[i]) else f"{st.strouhal[i]:.4f}"
+        stn = f"{st.strouhal[i]:.4f}" if not math.isnan(st.strouhal[i]) else (
+            "steady" if st.lift_rms[i] < SHEDDING_THRESHOLD else "unresolved (< 2 periods)")
         lines.append(f"| {a:g} | {st.drag[i]:.4f} | {st.lift[i]:.4f} | {st.moment[i]:.4f} | {st.lift_rms[i]:.2e} "
                      f"| {stn} | " + ", ".join(f"{x:+.1e}" for x in st.settling[i]) + " |")
     (cd, dcd), (cl, dcl), (cm, dcm) = (st.fit(v) for v in (st.drag, st.lift, st.moment))

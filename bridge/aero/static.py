@@ -30,7 +30,9 @@ import numpy as np
 
 from bridge.aero.forced_motion import ForceRecord
 
-__all__ = ["StaticCoefficients", "static_coefficients", "shedding_frequency", "window_mean"]
+SHEDDING_THRESHOLD = 1e-4   # lift coefficient rms below which a wake counts as steady
+
+__all__ = ["SHEDDING_THRESHOLD", "StaticCoefficients", "static_coefficients", "shedding_frequency", "window_mean"]
 
 
 def window_mean(t: np.ndarray, x: np.ndarray, start: float, end: float | None = None) -> float:
@@ -43,7 +45,7 @@ def window_mean(t: np.ndarray, x: np.ndarray, start: float, end: float | None = 
     return float(np.sum(0.5 * (xs[1:] + xs[:-1]) * np.diff(ts)) / (ts[-1] - ts[0]))
 
 
-def shedding_frequency(t: np.ndarray, x: np.ndarray, threshold: float = 1e-4,
+def shedding_frequency(t: np.ndarray, x: np.ndarray, threshold: float = SHEDDING_THRESHOLD,
                        min_cycles: float = 2.0) -> tuple[float, float]:
     """Dominant frequency (cycles per unit time) of the fluctuation of ``x`` and its rms.
 
@@ -81,7 +83,7 @@ class StaticCoefficients:
     lift: np.ndarray          # C_L (up)
     moment: np.ndarray        # C_M (nose-up, about the reference point)
     lift_rms: np.ndarray      # rms of the lift coefficient's fluctuation
-    frequency: np.ndarray     # shedding frequency f B / V (NaN: steady wake)
+    frequency: np.ndarray     # shedding frequency f B / V (NaN: steady wake, or < 2 periods in the window)
     settling: np.ndarray      # (angles, 3): change of C_D, C_L, C_M from the third to the last quarter
     depth_over_chord: float   # D / B of the section
     window: tuple[float, float]
@@ -100,7 +102,8 @@ class StaticCoefficients:
         return float(at0), float(slope)
 
     def quasi_steady(self):
-        """The quasi-steady model of these coefficients (values at alpha = 0, slopes of the line fits)."""
+        """The quasi-steady model of these coefficients (values at alpha = 0, slopes of the line fits; a
+        negative drag, which only a run gone wrong gives, enters as 0 - the stage warns)."""
         from bridge.flutter.aerodynamics import QuasiSteady
 
         if self.angles_deg.size < 2:

@@ -168,7 +168,9 @@ class FlutterOptions:
             if cfd is None:
                 raise InputError("flutter.aerodynamics", "cfd", "needs the aero stage's result (run it: it is "
                                  "planned automatically with the flutter stage)")
-            base = cfd
+            # the aero stage completes its table with the lateral terms of its static runs; a scenario's own
+            # [flutter.quasi_steady] takes their place (below)
+            base = cfd.base if self.quasi_steady is not None and isinstance(cfd, WithLateral) else cfd
         elif self.aerodynamics == "derivatives":
             base = DerivativeTable.from_csv(resolve(self.derivatives_path), convention=self.derivatives_convention,
                                             missing=self.missing_derivatives)

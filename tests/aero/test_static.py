@@ -93,3 +93,43 @@ def test_a_thin_plate_held_still_has_thin_aerofoil_slopes_and_symmetry():
     _, dcm = st.fit(st.moment)
     assert 0.8 * 2 * np.pi < dcl < 1.05 * 2 * np.pi, dcl
     assert 0.20 < dcm / dcl < 0.30, (dcm, dcl)
+
+
+def test_the_static_group_report_and_lateral_model(tmp_path):
+    """results.h5 /aero/static as docs/results.md lists it (every dataset with unit and description), the
+    report's wording for a steady and an unresolved wake, and the flutter model: the CFD table completed by
+    the static runs' lateral terms, unless the scenario gives its own [flutter.quasi_steady]."""
+    import h5py
+
+    from bridge.aero.stage import _static_report, _write_static_h5
+    from bridge.flutter.aerodynamics import Theodorsen, WithLateral
+    from bridge.flutter.options import FlutterOptions
+
+    st = dataclasses.replace(
+        static_coefficients([ForceRecord(t=np.linspace(0, 10, 101), lift=np.full(101, a), drag=np.full(101, 0.1),
+                                         moment=np.full(101, a / 4), motion=np.zeros(101)) for a in (-0.1, 0.0, 0.1)],
+                            (-2.0, 0.0, 2.0), 0.1),
+        lift_rms=np.array([0.0, 0.0, 0.05]))
+    with h5py.File(tmp_path / "r.h5", "w") as h5:
+        _write_static_h5(h5.create_group("static"), st)
+    with h5py.File(tmp_path / "r.h5", "r") as h5:
+        g = h5["static"]
+        names = []
+        g.visititems(lambda n, o: names.append(n) if isinstance(o, h5py.Dataset) else None)
+        assert {"angle_of_attack", "drag_coefficient", "lift_coefficient", "moment_coefficient", "lift_rms",
+                "shedding_frequency", "strouhal_on_depth", "settling", "fit/lift_slope",
+                "fit/drag_at_zero"} <= set(names)
+        for n in names:
+            assert g[n].attrs["unit"] is not None and g[n].attrs["description"], n
+        assert g["fit/lift_slope"][()] == pytest.approx(0.2 / np.radians(2.0))   # C_L = 2 x the CFD lift
+        assert g.attrs["depth_over_chord"] == 0.1
+    text = "\n".join(_static_report(st))
+    assert "| steady |" in text and "unresolved" in text
+    static_qs = st.quasi_steady()
+    cfd = WithLateral(Theodorsen(), static_qs)
+    assert FlutterOptions(aerodynamics="cfd").aerodynamic_model(cfd=cfd).lateral is static_qs
+    own = FlutterOptions.from_mapping({"aerodynamics": "cfd", "quasi_steady": {
+        "lift_coefficient": 0.0, "lift_slope_per_rad": 5.0, "drag_coefficient": 0.3, "moment_coefficient": 0.0,
+        "moment_slope_per_rad": 1.0}})
+    model = own.aerodynamic_model(cfd=cfd)
+    assert model.base is cfd.base and model.lateral.drag_coefficient == 0.3
