@@ -242,9 +242,9 @@ def write_results(out_root: Path, scenario: Scenario, outputs: Mapping[str, Stag
                    f"{', '.join(outputs)}.  Details per stage follow.", ""]
         for out in outputs.values():
             report += [out.report.rstrip(), ""]
-            for fname, png in out.figures.items():
-                (tmp / fname).write_bytes(png)
-                report += [f"![{fname}]({fname})", ""]
+            for fname, data in out.figures.items():
+                (tmp / fname).write_bytes(data)
+                report += [f"![{fname}]({fname})" if fname.endswith(".png") else f"File [{fname}]({fname}).", ""]
         (tmp / "report.md").write_text("\n".join(report))
         files = sorted(p.name for p in tmp.iterdir()) + ["summary.json"]
         summary["run.files"] = files

@@ -29,7 +29,8 @@ class StageOutput:
                dataset in ``docs/results.md``.
     report   - a Markdown section for ``report.md`` (starts with a ``## `` heading).
     figures  - ``{"file_name.png": matplotlib.figure.Figure}``, or PNG bytes once stored
-               (:func:`bridge.cache.store`).
+               (:func:`bridge.cache.store`); other files of the result folder as bytes
+               (``{"aero_pitch_flow.xdmf": b"..."}``: the report links them instead of showing them).
     data     - the stage's Python result object, for later stages.
     from_cache - True when the output was taken from the stage cache instead of computed.
     """

@@ -236,6 +236,7 @@ class ForceRecord:
     wall_s: float = 0.0
     resumed_from_step: int = 0
     meta: dict = field(default_factory=dict)
+    snapshot: dict | None = None    # the flow at the end of the run (bridge.aero.snapshots.flow_snapshot)
 
 
 def _grid(q: Quality, reach: float):
@@ -365,9 +366,12 @@ def run_case(shape, case: ForcedCase | StaticCase, quality: Quality, checkpoint:
     if checkpoint is not None:
         _save_checkpoint(checkpoint, key, sim, rec)
     arrays = {n: np.asarray(v, dtype=np.float64) for n, v in rec.items()}
+    from bridge.aero.snapshots import flow_snapshot
+
+    snap = flow_snapshot(grid, sim.u.numpy(), sim.v.numpy(), sim.p.numpy(), polys, case.motion().pose(sim.t), sim.t)
     return ForceRecord(**arrays, steps=sim.n_steps, wall_s=time.perf_counter() - t0, resumed_from_step=resumed,
                        meta={"nx": grid.nx, "ny": grid.ny, "reynolds": q.reynolds, "quality": q.name,
-                             **asdict(case)})
+                             **asdict(case)}, snapshot=snap)
 
 
 def whole_periods(record: ForceRecord, case: ForcedCase, q: Quality) -> np.ndarray:

@@ -27,6 +27,7 @@ import numpy as np
 from bridge.aero.forced_motion import QUALITY, ForcedCase, StaticCase, case_key, run_case, whole_periods
 from bridge.aero.frequency_response import forced_motion_response
 from bridge.aero.options import AeroOptions
+from bridge.aero.snapshots import snapshot_files
 from bridge.aero.static import SHEDDING_THRESHOLD, StaticCoefficients, static_coefficients
 from bridge.flutter.aerodynamics import WithLateral
 from bridge.flutter.derivatives import DERIVATIVE_NAMES, FRF, VERTICAL_TORSIONAL, derivatives_from_frf
@@ -121,7 +122,13 @@ def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
         records.append({"dof": case.dof, "K": case.fundamental, "Ks": list(ks), "steps": rec.steps,
                         "wall_s": rec.wall_s, "resumed_from_step": rec.resumed_from_step,
                         "periods": responses[0].periods, "t": rec.t, "lift": rec.lift, "moment": rec.moment,
-                        "motion": rec.motion, "window": (float(rec.t[sel][0]), float(rec.t[sel][-1]))})
+                        "motion": rec.motion, "window": (float(rec.t[sel][0]), float(rec.t[sel][-1])),
+                        "snapshot": rec.snapshot})
+    for dof in ("heave", "pitch"):   # keep the flow of the case whose forces are plotted (_figures), drop the rest
+        same = [r for r in records if r["dof"] == dof]
+        for r in same:
+            if r is not same[len(same) // 2]:
+                r["snapshot"] = None
     static, static_records = _static_runs(poly, section, aopts, q, runs, options)
     frf, stderr = FRF(**values), FRF(**errors)
     measured = VERTICAL_TORSIONAL + (("h_qu", "h_qtheta") if aopts.excitation == "single" else ())
@@ -327,6 +334,8 @@ def _figures(d: AeroResult) -> dict[str, Any]:
         uvs = ", ".join(f"{2 * math.pi / k:.2f}" for k in r["Ks"])
         ax.set_title(f"Forced {dof}, K = {ks} (U/(fB) = {uvs})")
         figs[f"aero_{dof}_forces.png"] = fig
+        if r.get("snapshot") is not None:
+            figs.update(snapshot_files(f"aero_{dof}_flow", r["snapshot"], f"Forced {dof}, K = {_ks(r)}"))
     if d.static is not None:
         figs["aero_static.png"] = _static_figure(d)
     return figs
