@@ -28,7 +28,7 @@ from bridge.aero.forced_motion import (  # noqa: E402
     THESIS_HEAVE_RATE,
     THESIS_PITCH_RATE,
     ForcedCase,
-    case_key,
+    checkpoint_path,
     run_case,
     whole_periods,
 )
@@ -42,11 +42,6 @@ from bridge.flutter.derivatives import FRF, derivatives_from_frf  # noqa: E402
 NAMES = ("H1", "H2", "H3", "H4", "A1", "A2", "A3", "A4")
 
 
-def _checkpoint(runs: Path | None, poly, case, q) -> Path | None:
-    """Where a case keeps its checkpoint (and so its record): a killed run resumes, a finished one is read back."""
-    return None if runs is None else runs / f"{case_key(poly, case, q)[:24]}.h5"
-
-
 def plate_derivatives(reduced_velocity: float, quality: str, thickness: float, say=print,
                       runs: Path | None = None) -> dict:
     poly = _unit_polygon(FlatPlate(1.0, thickness))
@@ -55,7 +50,7 @@ def plate_derivatives(reduced_velocity: float, quality: str, thickness: float, s
     h, wall = {}, 0.0
     for dof in ("heave", "pitch"):
         case = ForcedCase.thesis(dof, K)
-        rec = run_case(poly, case, q, _checkpoint(runs, poly, case, q), progress=say,
+        rec = run_case(poly, case, q, checkpoint_path(runs, poly, case, q), progress=say,
                        label=f"U/(fB) = {reduced_velocity:g} {dof}")
         wall += rec.wall_s
         sel = whole_periods(rec, case, q)
@@ -88,7 +83,8 @@ def multi_frequency_check(reduced_velocities, quality: str, thickness: float, si
     rows = []
     for dof, rate in (("heave", THESIS_HEAVE_RATE), ("pitch", THESIS_PITCH_RATE)):
         case = ForcedCase.multi_frequency(dof, Ks, rate)
-        rec = run_case(poly, case, q, _checkpoint(runs, poly, case, q), progress=say, label=f"multi-frequency {dof}")
+        rec = run_case(poly, case, q, checkpoint_path(runs, poly, case, q), progress=say,
+                       label=f"multi-frequency {dof}")
         sel = whole_periods(rec, case, q)
         out = forced_motion_response(rec.t[sel], rec.motion[sel], list(Ks), dof=dof, speed_m_s=1.0, deck_width_m=1.0,
                                      air_density_kg_m3=1.0, lift=rec.lift[sel], moment=rec.moment[sel],

@@ -36,7 +36,8 @@ import numpy as np
 
 from bridge.errors import InputError, check_range
 
-__all__ = ["Quality", "QUALITY", "ForcedCase", "StaticCase", "ForceRecord", "run_case", "case_key", "whole_periods",
+__all__ = ["Quality", "QUALITY", "ForcedCase", "StaticCase", "ForceRecord", "run_case", "case_key",
+           "checkpoint_path", "whole_periods",
            "THESIS_HEAVE_RATE", "THESIS_PITCH_RATE"]
 
 THESIS_HEAVE_RATE = 0.4 / 50.0            # udot_0 / V (thesis 5.3)
@@ -266,6 +267,11 @@ def case_key(shape, case: ForcedCase, q: Quality) -> str:
                        "quality": asdict(q), "code": _code_digest(("bridge.cfd", "kernels.cfd",
                                                                     "bridge.aero.forced_motion"))}, sort_keys=True)
     return hashlib.sha256(blob.encode()).hexdigest()
+
+
+def checkpoint_path(runs: Path | None, shape, case, q: Quality) -> Path | None:
+    """Where a case keeps its checkpoint in the folder ``runs`` (None: no checkpoint): named by its key."""
+    return None if runs is None else Path(runs) / f"{case_key(shape, case, q)[:24]}.h5"
 
 
 def _save_checkpoint(path: Path, key: str, sim, rec: dict) -> None:

@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from bridge.aero.forced_motion import QUALITY, ForcedCase, StaticCase, case_key, run_case, whole_periods
+from bridge.aero.forced_motion import QUALITY, ForcedCase, StaticCase, checkpoint_path, run_case, whole_periods
 from bridge.aero.frequency_response import forced_motion_response
 from bridge.aero.options import AeroOptions
 from bridge.aero.snapshots import snapshot_files
@@ -103,8 +103,8 @@ def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
         ks = case.reduced_frequencies
         what = ", ".join(f"{2 * np.pi / k:.3g}" for k in ks)
         label = f"aero case {n + 1}/{len(cases)}, {case.dof} U/(fB) = {what}"
-        checkpoint = None if runs is None else runs / f"{case_key(poly, case, q)[:24]}.h5"
-        rec = run_case(poly, case, q, checkpoint, aopts.checkpoint_every, progress=options.say, label=label)
+        rec = run_case(poly, case, q, checkpoint_path(runs, poly, case, q), aopts.checkpoint_every,
+                       progress=options.say, label=label)
         sel = whole_periods(rec, case, q)
         # a multi-frequency run's drag is no FRF: drag is quadratic in the motion, and twice one frequency is
         # another of the set (h_qu, h_qtheta then come from the static runs' quasi-steady model)
@@ -160,8 +160,8 @@ def _static_runs(poly, section, aopts: AeroOptions, q, runs, options: RunOptions
     for n, angle in enumerate(angles):
         case = StaticCase(angle, grid_angle_deg=max(abs(a) for a in angles))
         label = f"aero static {n + 1}/{len(angles)}, angle {angle:g} deg"
-        checkpoint = None if runs is None else runs / f"{case_key(poly, case, q)[:24]}.h5"
-        rec = run_case(poly, case, q, checkpoint, aopts.checkpoint_every, progress=options.say, label=label)
+        rec = run_case(poly, case, q, checkpoint_path(runs, poly, case, q), aopts.checkpoint_every,
+                       progress=options.say, label=label)
         recs.append(rec)
         records.append({"angle_deg": angle, "steps": rec.steps, "wall_s": rec.wall_s,
                         "resumed_from_step": rec.resumed_from_step, "t": rec.t, "lift": rec.lift,
@@ -181,7 +181,7 @@ def _summary(d: AeroResult) -> dict[str, Any]:
                          "aero.reduced_velocity_max": float(d.reduced_velocity.max()),
                          "aero.cfd_wall_s": float(sum(r["wall_s"] for r in d.records + d.static_records))}
     if d.static is not None:
-        (cd, dcd), (cl, dcl), (cm, dcm) = (d.static.fit(v) for v in (d.static.drag, d.static.lift, d.static.moment))
+        (cd, dcd), (cl, dcl), (cm, dcm) = d.static.fits()
         i0 = int(np.argmin(np.abs(d.static.angles_deg)))
         st = float(d.static.strouhal[i0])
         s.update({"aero.static.drag_coefficient": cd, "aero.static.drag_slope_per_rad": dcd,
@@ -285,7 +285,7 @@ def _static_report(st: StaticCoefficients) -> list[str]:
             "steady" if st.lift_rms[i] < SHEDDING_THRESHOLD else "unresolved (< 2 periods)")
         lines.append(f"| {a:g} | {st.drag[i]:.4f} | {st.lift[i]:.4f} | {st.moment[i]:.4f} | {st.lift_rms[i]:.2e} "
                      f"| {stn} | " + ", ".join(f"{x:+.1e}" for x in st.settling[i]) + " |")
-    (cd, dcd), (cl, dcl), (cm, dcm) = (st.fit(v) for v in (st.drag, st.lift, st.moment))
+    (cd, dcd), (cl, dcl), (cm, dcm) = st.fits()
     lines += ["", f"Line fits: C_D = {cd:.4f} + {dcd:.4f} alpha, C_L = {cl:.4f} + {dcl:.4f} alpha, "
               f"C_M = {cm:.4f} + {dcm:.4f} alpha (alpha in rad; thin-plate theory: dC_L/dalpha = 2 pi = 6.283, "
               "dC_M/dalpha = pi/2 = 1.571 about mid-chord).  With aerodynamics = \"cfd\" these give the flutter "

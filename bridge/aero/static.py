@@ -101,6 +101,10 @@ class StaticCoefficients:
         slope, at0 = np.polyfit(a, values, 1)
         return float(at0), float(slope)
 
+    def fits(self) -> tuple[tuple[float, float], ...]:
+        """:meth:`fit` of C_D, C_L and C_M, in that order."""
+        return tuple(self.fit(v) for v in (self.drag, self.lift, self.moment))
+
     def quasi_steady(self):
         """The quasi-steady model of these coefficients (values at alpha = 0, slopes of the line fits; a
         negative drag, which only a run gone wrong gives, enters as 0 - the stage warns)."""
@@ -108,7 +112,7 @@ class StaticCoefficients:
 
         if self.angles_deg.size < 2:
             raise ValueError("the quasi-steady model needs the slopes: at least 2 angles")
-        (cd, dcd), (cl, dcl), (cm, dcm) = (self.fit(v) for v in (self.drag, self.lift, self.moment))
+        (cd, dcd), (cl, dcl), (cm, dcm) = self.fits()
         return QuasiSteady(lift_coefficient=cl, lift_slope_per_rad=dcl, drag_coefficient=max(cd, 0.0),
                            moment_coefficient=cm, moment_slope_per_rad=dcm, drag_slope_per_rad=dcd,
                            name="quasi_steady (CFD static coefficients)")
