@@ -107,8 +107,14 @@ def _finished_with(folder: Path) -> str | None:
         return None
 
 
-def _worker_start() -> None:
-    """Sweep worker processes leave Ctrl-C to the parent, which asks each running case to stop."""
+_STOPPING = None  # in a worker process: the sweep's "stop" event (set by the parent on Ctrl-C)
+
+
+def _worker_start(stopping=None) -> None:
+    """Sweep worker processes leave Ctrl-C to the parent, which asks each running case to stop and
+    sets ``stopping`` so that cases already handed to the pool's queue are not started."""
+    global _STOPPING
+    _STOPPING = stopping
     signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
@@ -128,6 +134,8 @@ def run_case(case: Case, out_dir: str, stages: list[str] | None, quick: bool,
     if in_worker:  # a running case stops on Ctrl-C (the parent forwards it), cleaning up after itself
         signal.signal(signal.SIGINT, signal.default_int_handler)
     try:
+        if in_worker and _STOPPING is not None and _STOPPING.is_set():
+            raise KeyboardInterrupt   # queued before the Ctrl-C, which cancel() cannot take back
         key = case_key(case, stages, quick)
         folder = Path(out_dir) / case.name
         if _finished_with(folder) == key:
@@ -292,19 +300,30 @@ def run_sweep(cases: list[Case], sweep_dir: Path, stages: list[str] | None = Non
         for c in cases:
             report(*run_case(c, str(cases_dir), stages, quick, cache))
     else:
-        pool = ProcessPoolExecutor(max_workers=workers, initializer=_worker_start)
+        context = multiprocessing.get_context()
+        stopping = context.Event()   # handed to the workers as they start (inheritance, as Event needs)
+        pool = ProcessPoolExecutor(max_workers=workers, mp_context=context,
+                                   initializer=_worker_start, initargs=(stopping,))
+        futs = []
         try:
             futs = [pool.submit(run_case, c, str(cases_dir), stages, quick, cache) for c in cases]
             for fut in as_completed(futs):
                 report(*fut.result())
         except KeyboardInterrupt:
+            stopping.set()
             for f in futs:
                 f.cancel()
             for child in multiprocessing.active_children():  # a Ctrl-C sent to us alone reaches them too
                 if child.pid is not None:
                     with contextlib.suppress(OSError):
                         os.kill(child.pid, signal.SIGINT)
-            pool.shutdown(wait=True, cancel_futures=True)
+            try:
+                pool.shutdown(wait=True, cancel_futures=True)
+            finally:
+                # an interrupt inside submit() (workers forked, the pool's manager not yet running) leaves
+                # workers that ignore SIGINT and wait on the pool's pipes for ever: end them
+                for child in multiprocessing.active_children():
+                    child.terminate()
             raise
         pool.shutdown(wait=True)
     return status
