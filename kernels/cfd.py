@@ -67,9 +67,10 @@ def upwind_flux(vel: wp.float64, q_m2: wp.float64, q_m1: wp.float64, q_p1: wp.fl
 def yflux_u_row(u: wp.array2d(dtype=wp.float64), v: wp.array2d(dtype=wp.float64),
                 nu: wp.array2d(dtype=wp.float64), hy_c: wp.array(dtype=wp.float64),
                 hy_f: wp.array(dtype=wp.float64), dx: wp.float64, J: int, i_lo: int, i_hi: int, scheme: int,
-                flux: wp.array2d(dtype=wp.float64), frow: int):
+                gy_u: wp.array(dtype=wp.float64), flux: wp.array2d(dtype=wp.float64), frow: int):
     """y-flux of x-momentum (advective - viscous) at the corners of v-face row J, u columns I, into
-    ``flux[frow, I]``: computed once per corner and shared by the u-faces above and below."""
+    ``flux[frow, I]``: computed once per corner and shared by the u-faces above and below. The
+    advecting velocity is relative to the grid (``gy_u[I]``: the grid's y-velocity on u column I)."""
     half = wp.float64(0.5)
     one = wp.float64(1.0)
     ihf = one / hy_f[J]
@@ -85,7 +86,7 @@ def yflux_u_row(u: wp.array2d(dtype=wp.float64), v: wp.array2d(dtype=wp.float64)
         nr = nu[J - 1, I] + nu[J, I]
         ub = u[J - 1, I]
         ua = u[J, I]
-        flux[frow, I] = upwind_flux(half * (vl + vr), u[J - 2, I], ub, ua, u[J + 1, I], rm, rp, w, scheme) \
+        flux[frow, I] = upwind_flux(half * (vl + vr) - gy_u[I], u[J - 2, I], ub, ua, u[J + 1, I], rm, rp, w, scheme) \
             - wp.float64(0.25) * (nl + nr) * ((ua - ub) * ihf + (vr - vl) * idx)
         vl = vr
         nl = nr
@@ -94,15 +95,16 @@ def yflux_u_row(u: wp.array2d(dtype=wp.float64), v: wp.array2d(dtype=wp.float64)
 @wp.func
 def yflux_v_row(v: wp.array2d(dtype=wp.float64), nu: wp.array2d(dtype=wp.float64),
                 hy_c: wp.array(dtype=wp.float64), J: int, i_lo: int, i_hi: int, scheme: int,
-                flux: wp.array2d(dtype=wp.float64), frow: int):
+                gy_c: wp.array(dtype=wp.float64), flux: wp.array2d(dtype=wp.float64), frow: int):
     """y-flux of y-momentum (advective - viscous) at the cell centres of row J into ``flux[frow, I]``,
-    shared by the v-faces J and J+1."""
+    shared by the v-faces J and J+1 (advecting velocity relative to the grid: ``gy_c[I]``, the grid's
+    y-velocity on cell column I)."""
     half = wp.float64(0.5)
     ihc = wp.float64(1.0) / hy_c[J]
     rm = hy_c[J] / hy_c[J - 1]
     rp = hy_c[J] / hy_c[J + 1]
     for I in range(i_lo, i_hi):
-        vc = half * (v[J, I] + v[J + 1, I])
+        vc = half * (v[J, I] + v[J + 1, I]) - gy_c[I]
         flux[frow, I] = upwind_flux(vc, v[J - 1, I], v[J, I], v[J + 1, I], v[J + 2, I], rm, rp, half, scheme) \
             - wp.float64(2.0) * nu[J, I] * (v[J + 1, I] - v[J, I]) * ihc
 
@@ -120,8 +122,11 @@ def predict_u(u: wp.array2d(dtype=wp.float64), v: wp.array2d(dtype=wp.float64),
               hy_c: wp.array(dtype=wp.float64), hy_f: wp.array(dtype=wp.float64),
               dx: wp.float64, dt: wp.float64, a: wp.float64, b: wp.float64,
               i_lo: int, i_hi: int, j_start: int, n_rows: int, n_blocks: int, use_p: int, scheme: int,
-              block0: int, scratch: wp.array2d(dtype=wp.float64)):
-    """out = a*u0 + b*(u + dt*(-div(u u) + div(2 nu S)_x [- dp/dx])) on the u-faces of a block of rows.
+              block0: int, scratch: wp.array2d(dtype=wp.float64),
+              gx_c: wp.array(dtype=wp.float64), gx_f: wp.array(dtype=wp.float64),
+              gy_c: wp.array(dtype=wp.float64), gy_u: wp.array(dtype=wp.float64), om: wp.float64):
+    """out = a*u0 + b*(u + dt*(-div(u w) + div(2 nu S)_x [- dp/dx] + om v)) on the u-faces of a block
+    of rows, w = u - u_grid.
 
     Conservative advection (limited upwind-biased) and the full variable-viscosity stress
     nu (grad u + grad u^T) so an eddy viscosity nu_t(x, y) plugs in through ``nu``; the pressure
@@ -129,6 +134,12 @@ def predict_u(u: wp.array2d(dtype=wp.float64), v: wp.array2d(dtype=wp.float64),
     block's rows run bottom to top; the y-flux row above each row (``yflux_u_row``) goes to one of the
     block's two ``scratch`` rows and serves as the row below for the next row (computed once, read
     from cache); the x-flux is carried along the row.
+
+    Moving frame (``bridge.cfd.overset``): the grid moves rigidly with velocity u_grid = (gx, gy)
+    (``gx_c[J]``/``gx_f[J]``: x-velocity at the heights of cell centres / v-faces of storage row J;
+    ``gy_c[I]``/``gy_u[I]``: y-velocity at the x of cell centres / u-faces of storage column I) and
+    turns at ``om``; (u, v) are the absolute velocity in the grid's axes, advected by the velocity
+    relative to the grid, with the source -om x u of the turning axes. A fixed grid passes zeros.
     """
     blk = block0 + wp.tid()
     r0, r1 = block_rows(blk, n_blocks, j_start, n_rows)
@@ -137,30 +148,33 @@ def predict_u(u: wp.array2d(dtype=wp.float64), v: wp.array2d(dtype=wp.float64),
     two = wp.float64(2.0)
     idx = one / dx
     s = 2 * blk
-    yflux_u_row(u, v, nu, hy_c, hy_f, dx, r0, i_lo, i_hi, scheme, scratch, s)
+    yflux_u_row(u, v, nu, hy_c, hy_f, dx, r0, i_lo, i_hi, scheme, gy_u, scratch, s)
     for J in range(r0, r1):
         lo = s + (J - r0) % 2
         hi = s + (J - r0 + 1) % 2
-        yflux_u_row(u, v, nu, hy_c, hy_f, dx, J + 1, i_lo, i_hi, scheme, scratch, hi)
+        yflux_u_row(u, v, nu, hy_c, hy_f, dx, J + 1, i_lo, i_hi, scheme, gy_u, scratch, hi)
         ihc = one / hy_c[J]
+        gx = gx_c[J]
         # u[J, I-1 .. I+2] carried in registers along the row: one new load per face
         I = i_lo
         qm = u[J, I - 2]
         qc = u[J, I - 1]
         qp = u[J, I]
         qpp = u[J, I + 1]
-        fl = upwind_flux(half * (qc + qp), qm, qc, qp, qpp, one, one, half, scheme) \
+        fl = upwind_flux(half * (qc + qp) - gx, qm, qc, qp, qpp, one, one, half, scheme) \
             - two * nu[J, I - 1] * (qp - qc) * idx
         for I in range(i_lo, i_hi):
             qm = qc
             qc = qp
             qp = qpp
             qpp = u[J, I + 2]
-            fr = upwind_flux(half * (qc + qp), qm, qc, qp, qpp, one, one, half, scheme) \
+            fr = upwind_flux(half * (qc + qp) - gx, qm, qc, qp, qpp, one, one, half, scheme) \
                 - two * nu[J, I] * (qp - qc) * idx
             rhs = -(fr - fl) * idx - (scratch[hi, I] - scratch[lo, I]) * ihc
             if use_p != 0:
                 rhs -= (p[J, I] - p[J, I - 1]) * idx
+            if om != wp.float64(0.0):
+                rhs += om * wp.float64(0.25) * (v[J, I - 1] + v[J, I] + v[J + 1, I - 1] + v[J + 1, I])
             out[J, I] = a * u0[J, I] + b * (qc + dt * rhs)
             fl = fr
 
@@ -172,10 +186,13 @@ def predict_v(u: wp.array2d(dtype=wp.float64), v: wp.array2d(dtype=wp.float64),
               hy_c: wp.array(dtype=wp.float64), hy_f: wp.array(dtype=wp.float64),
               dx: wp.float64, dt: wp.float64, a: wp.float64, b: wp.float64,
               i_lo: int, i_hi: int, j_start: int, n_rows: int, n_blocks: int, use_p: int, scheme: int,
-              block0: int, scratch: wp.array2d(dtype=wp.float64)):
-    """out = a*v0 + b*(v + dt*(-div(v u) + div(2 nu S)_y [- dp/dy])) on the v-faces of a block of rows
-    (blocks, scratch rows and ``use_p`` as in ``predict_u``; the y-fluxes at the cell centres below
-    and above face row J come from ``yflux_v_row`` rows J-1 and J; x-flux carried along the row)."""
+              block0: int, scratch: wp.array2d(dtype=wp.float64),
+              gx_c: wp.array(dtype=wp.float64), gx_f: wp.array(dtype=wp.float64),
+              gy_c: wp.array(dtype=wp.float64), gy_u: wp.array(dtype=wp.float64), om: wp.float64):
+    """out = a*v0 + b*(v + dt*(-div(v w) + div(2 nu S)_y [- dp/dy] - om u)) on the v-faces of a block
+    of rows (blocks, scratch rows, ``use_p`` and the moving frame as in ``predict_u``; the y-fluxes
+    at the cell centres below and above face row J come from ``yflux_v_row`` rows J-1 and J; x-flux
+    carried along the row)."""
     blk = block0 + wp.tid()
     r0, r1 = block_rows(blk, n_blocks, j_start, n_rows)
     half = wp.float64(0.5)
@@ -183,12 +200,13 @@ def predict_v(u: wp.array2d(dtype=wp.float64), v: wp.array2d(dtype=wp.float64),
     quarter = wp.float64(0.25)
     idx = one / dx
     s = 2 * blk
-    yflux_v_row(v, nu, hy_c, r0 - 1, i_lo, i_hi, scheme, scratch, s)
+    yflux_v_row(v, nu, hy_c, r0 - 1, i_lo, i_hi, scheme, gy_c, scratch, s)
     for J in range(r0, r1):
         lo = s + (J - r0) % 2
         hi = s + (J - r0 + 1) % 2
-        yflux_v_row(v, nu, hy_c, J, i_lo, i_hi, scheme, scratch, hi)
+        yflux_v_row(v, nu, hy_c, J, i_lo, i_hi, scheme, gy_c, scratch, hi)
         ihf = one / hy_f[J]
+        gx = gx_f[J]
         # weights of u rows J-1 and J at the corner height (face row J)
         wl = half * hy_c[J] * ihf
         wu = half * hy_c[J - 1] * ihf
@@ -203,23 +221,27 @@ def predict_v(u: wp.array2d(dtype=wp.float64), v: wp.array2d(dtype=wp.float64),
         ua = u[J, I]
         nsum = nu[J - 1, I] + nu[J, I]
         nul = quarter * (nu[J - 1, I - 1] + nu[J, I - 1] + nsum)
-        fl = upwind_flux(wl * ub + wu * ua, qm, qc, qp, qpp, one, one, half, scheme) \
+        fl = upwind_flux(wl * ub + wu * ua - gx, qm, qc, qp, qpp, one, one, half, scheme) \
             - nul * ((qp - qc) * idx + (ua - ub) * ihf)
         for I in range(i_lo, i_hi):
             qm = qc
             qc = qp
             qp = qpp
             qpp = v[J, I + 2]
+            ubl = ub
+            ual = ua
             ub = u[J - 1, I + 1]
             ua = u[J, I + 1]
             nnext = nu[J - 1, I + 1] + nu[J, I + 1]
             nur = quarter * (nsum + nnext)
             nsum = nnext
-            fr = upwind_flux(wl * ub + wu * ua, qm, qc, qp, qpp, one, one, half, scheme) \
+            fr = upwind_flux(wl * ub + wu * ua - gx, qm, qc, qp, qpp, one, one, half, scheme) \
                 - nur * ((qp - qc) * idx + (ua - ub) * ihf)
             rhs = -(fr - fl) * idx - (scratch[hi, I] - scratch[lo, I]) * ihf
             if use_p != 0:
                 rhs -= (p[J, I] - p[J - 1, I]) * ihf
+            if om != wp.float64(0.0):
+                rhs -= om * half * (wl * (ubl + ub) + wu * (ual + ua))
             out[J, I] = a * v0[J, I] + b * (qc + dt * rhs)
             fl = fr
 

@@ -111,13 +111,14 @@ def bench_warp(sim, repeats, steps, device=None):
     rhs_buf = sim.rhs.numpy() if sim._host else None
     nb = sim.n_blocks
     pred = [sim.hy_c, sim.hy_f, sim.grid.dx, dt, 0.5, 0.5]
+    frame = [sim.frame_x, sim.frame_xf, sim.frame_y, sim.frame_yu, sim.frame_omega]
     parts = {
         "predict_u": lambda: L.rows(kc.predict_u, nb, 0, [sim.u, sim.v, sim.p, sim.nu, sim.u, sim.u_star, *pred,
                                                           g + 1, g + nx, g, ny, nb, 0, sim.scheme, ROW0,
-                                                          sim._scratch], min_split=2),
+                                                          sim._scratch, *frame], min_split=2),
         "predict_v": lambda: L.rows(kc.predict_v, nb, 0, [sim.u, sim.v, sim.p, sim.nu, sim.v, sim.v_star, *pred,
                                                           g, g + nx, g + 1, ny - 1, nb, 0, sim.scheme, ROW0,
-                                                          sim._scratch], min_split=2),
+                                                          sim._scratch, *frame], min_split=2),
         "boundaries": lambda: sim.bc.set_normal_faces(sim.u, sim.u, sim.u_star, sim.t, dt, 0.5, 0.5),
         "divergence": lambda: L.rows(kc.divergence, ny, 0, [sim.u_star, sim.v_star, sim.hy_c, sim.grid.dx,
                                                             1.0, g, nx, ROW0, sim.rhs]),

@@ -4,7 +4,8 @@ Public API: build a ``CartesianGrid``, a ``FlowConfig`` (with ``BoundaryConditio
 bodies (``Simulation.add_body`` with a ``Polygon`` and a motion), then ``run`` with monitors.
 Plug-in points for later issues: ``Simulation.set_viscosity`` (cell field nu + nu_t from a turbulence
 model before each step), the grid object (metrics), the Poisson solver object, body motions
-(anything with ``pose(t)``/``velocity(t)``). See docs/cfd.md.
+(anything with ``pose(t)``/``velocity(t)``), stage hooks (``StageHook``). ``OversetPair``: a fine body grid
+moving with the body over a fixed background (overset.py). See docs/cfd.md.
 """
 
 from .bodies import Polygon, box_deck, circle, flat_plate
@@ -13,13 +14,15 @@ from .grids import GHOST, CartesianGrid, stretched_faces
 from .immersed import ImmersedBody
 from .monitors import CFLMonitor, DivergenceMonitor, ForceHistory, NaNMonitor, max_divergence, run
 from .motion import HarmonicMotion, PrescribedMotion, Stationary, UniformTranslation
+from .overset import OversetPair
 from .precision import DTYPE
 from .pressure import PoissonSolver
-from .time_stepping import TIME_SCHEMES, FlowConfig, FlowDiverged, Simulation
+from .time_stepping import TIME_SCHEMES, FlowConfig, FlowDiverged, Simulation, StageHook
 
 __all__ = [
     "BoundaryConditions", "CartesianGrid", "CFLMonitor", "DivergenceMonitor", "DTYPE", "FlowConfig",
     "FlowDiverged", "ForceHistory", "GHOST", "HarmonicMotion", "ImmersedBody", "NaNMonitor",
-    "PoissonSolver", "Polygon", "PrescribedMotion", "Simulation", "Stationary", "TIME_SCHEMES",
+    "OversetPair", "PoissonSolver", "Polygon", "PrescribedMotion", "Simulation", "StageHook", "Stationary",
+    "TIME_SCHEMES",
     "UniformTranslation", "box_deck", "circle", "flat_plate", "max_divergence", "run", "stretched_faces",
 ]

@@ -39,13 +39,29 @@ from .launch import ROW0, RowLauncher
 from .precision import WP_DTYPE
 from .pressure import PoissonSolver
 
-__all__ = ["FlowConfig", "Simulation", "TIME_SCHEMES", "FlowDiverged"]
+__all__ = ["FlowConfig", "Simulation", "StageHook", "TIME_SCHEMES", "FlowDiverged"]
 
 # Shu-Osher form: stage k: u_{k+1} = a_k u^n + b_k (u_k + dt L(u_k)).
 TIME_SCHEMES = {
     "euler": ((0.0, 1.0),),
     "heun": ((0.0, 1.0), (0.5, 0.5)),  # SSP-RK2, second order
 }
+
+
+class StageHook:
+    """Called by ``Simulation.step`` in every stage (defaults do nothing): ``before_predict`` with the
+    time of the stage's input, ``after_predict`` once the predicted ``u_star``/``v_star`` have their
+    boundary faces (before the bodies' forcing and the projection), ``after_projection`` once the
+    stage's result ``u``/``v`` has its ghosts. ``c`` = b dt, the stage's projection factor."""
+
+    def before_predict(self, sim: Simulation, k: int, t_src: float) -> None:
+        pass
+
+    def after_predict(self, sim: Simulation, k: int, t_new: float, c: float) -> None:
+        pass
+
+    def after_projection(self, sim: Simulation, k: int, u, v, t_new: float) -> None:
+        pass
 
 
 class FlowDiverged(RuntimeError):
@@ -125,6 +141,13 @@ class Simulation:
         self._host = dev.is_cpu
         if self._host:  # zero-copy views for the FFT solve
             self._rhs_np = self.rhs.numpy()
+        # velocity of the grid (a moving frame, bridge.cfd.overset): zero for a fixed grid
+        self.frame_x = z(pshape[0])    # x-velocity at the heights of storage rows: cell centres
+        self.frame_xf = z(vshape[0])   # ... and v-faces
+        self.frame_y = z(pshape[1])    # y-velocity at the x of storage columns: cell centres
+        self.frame_yu = z(ushape[1])   # ... and u-faces
+        self.frame_omega = 0.0
+        self.hooks: list[StageHook] = []   # the overset coupling's frame and fringe (bridge.cfd.overset)
         self.t = 0.0
         self.n_steps = 0
         self.last_force = [np.zeros(3) for _ in self.bodies]
@@ -139,6 +162,20 @@ class Simulation:
         self.bodies.append(body)
         self.last_force.append(np.zeros(3))
         return body
+
+    def set_frame_velocity(self, vx: float, vy: float, omega: float) -> None:
+        """The grid moves rigidly: its point (x, y) (grid coordinates) has the velocity
+        (vx - omega y, vy + omega x) in the grid's axes, which turn at ``omega``. The state is then the
+        absolute velocity in the grid's axes (the predictor advects it with the velocity relative to
+        the grid and adds the turning axes' source, kernels.cfd.predict_u). (0, 0, 0): a fixed grid."""
+        g, gr = GHOST, self.grid
+        xc = gr.x_faces[0] + (np.arange(self.frame_y.shape[0]) - g + 0.5) * gr.dx
+        xu = gr.x_faces[0] + (np.arange(self.frame_yu.shape[0]) - g) * gr.dx
+        self.frame_x.assign(vx - omega * gr.storage_y_centres())
+        self.frame_xf.assign(vx - omega * gr.storage_y_faces())
+        self.frame_y.assign(vy + omega * xc)
+        self.frame_yu.assign(vy + omega * xu)
+        self.frame_omega = float(omega)
 
     def set_viscosity(self, nu_eff) -> None:
         """Effective viscosity nu + nu_t on the cells (the turbulence-model plug-in).
@@ -225,10 +262,12 @@ class Simulation:
         dx, s, nb = self.grid.dx, self.scheme, self.n_blocks
         use_p = int(self.config.pressure == "incremental")
         common = [self.hy_c, self.hy_f, dx, dt, a, b]
+        frame = [self.frame_x, self.frame_xf, self.frame_y, self.frame_yu, self.frame_omega]
         self.L.rows(_k.predict_u, nb, 0, [src_u, src_v, self.p, self.nu, u0, self.u_star, *common,
-                                          g + 1, g + nx, g, ny, nb, use_p, s, ROW0, self._scratch], min_split=2)
+                                          g + 1, g + nx, g, ny, nb, use_p, s, ROW0, self._scratch, *frame],
+                    min_split=2)
         self.L.rows(_k.predict_v, nb, 0, [src_u, src_v, self.p, self.nu, v0, self.v_star, *common,
-                                          g, g + nx, g + 1, ny - 1, nb, use_p, s, ROW0, self._scratch],
+                                          g, g + nx, g + 1, ny - 1, nb, use_p, s, ROW0, self._scratch, *frame],
                     min_split=2)
 
     def _project(self, dst_u, dst_v, c):
@@ -257,12 +296,18 @@ class Simulation:
         for k, (a, b) in enumerate(self.stages):
             last = k == n - 1
             dst_u, dst_v = (self.u, self.v) if last else (self.u_stage, self.v_stage)
+            for hook in self.hooks:   # the stage's input is at t (first stage) or t_new (SSP RK2/Euler)
+                hook.before_predict(self, k, self.t if k == 0 else t_new)
             self._predict(src_u, src_v, self.u, self.v, dt, a, b)
             self.bc.set_normal_faces(self.u, src_u, self.u_star, t_new, dt, a, b)
+            for hook in self.hooks:
+                hook.after_predict(self, k, t_new, b * dt)
             for body in self.bodies:
                 body.apply(self.u_star, self.v_star, k, p_comp, b * dt)
             self._project(dst_u, dst_v, b * dt)
             self.bc.fill_ghosts(dst_u, dst_v)
+            for hook in self.hooks:
+                hook.after_projection(self, k, dst_u, dst_v, t_new)
             src_u, src_v = dst_u, dst_v
         weights = [float(np.prod([bb for _, bb in self.stages[k + 1:]])) for k in range(n)]
         self.last_force = [body.force(weights, dt, self.t, t_new, self.config.rho) for body in self.bodies]
