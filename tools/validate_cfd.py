@@ -46,6 +46,7 @@ from bridge.cfd import (  # noqa: E402
     HarmonicMotion,
     ImmersedBody,
     NaNMonitor,
+    OversetPair,
     Simulation,
     Stationary,
     box_deck,
@@ -172,43 +173,65 @@ def dfg_cells_across(ppd):
     return int(round(DFG_H / (DFG_D / ppd)))
 
 
-def dfg(ppd, t_end, threads, scheme, ib_order=1, ny_shift=0):
+def dfg(ppd, t_end, threads, scheme, ib_order=1, ny_shift=0, overset=None):
     """DFG 2D-1 on a uniform grid h = D/ppd; ``ny_shift`` adds cells across the channel (dy =
-    0.41/(ny + ny_shift), nearly the same resolution, the cylinder cut differently by the grid)."""
+    0.41/(ny + ny_shift), nearly the same resolution, the cylinder cut differently by the grid).
+    ``overset`` = background cells per diameter: the cylinder in a body grid of h = D/ppd spanning
+    +-1 D around it (``bridge.cfd.OversetPair``) over a uniform background of h = D/overset."""
     d, h_ch, length, nu, umax = DFG_D, DFG_H, 2.2, 1e-3, 0.3
-    h = d / ppd
-    nx = int(round(length / h))
-    ny = dfg_cells_across(ppd) + ny_shift
-    grid = CartesianGrid.uniform(nx, ny, (0.0, length), (0.0, h_ch))
 
     def profile(y, t):
         return 4 * umax * y * (h_ch - y) / h_ch ** 2
 
     bc = BoundaryConditions(left="inflow", right="outflow", bottom="noslip", top="noslip", inflow_profile=profile)
     cfg = FlowConfig(nu=nu, advection=scheme, cfl=0.5, fourier=0.2, threads=threads, bc=bc)
-    sim = Simulation(grid, cfg)
-    sim.bodies = [ImmersedBody(circle(d), Stationary(0.2, 0.2), grid, sim.L, order=ib_order)]
+    bg_ppd = overset if overset is not None else ppd
+    h = d / bg_ppd
+    nx = int(round(length / h))
+    ny = dfg_cells_across(bg_ppd) + ny_shift
+    grid = CartesianGrid.uniform(nx, ny, (0.0, length), (0.0, h_ch))
     yc = grid.y_centres
-    sim.set_state(u=np.broadcast_to(profile(yc, 0)[:, None], (ny, nx + 1)))
-    hist, nan = ForceHistory(), NaNMonitor(every=200)
+    u0 = np.broadcast_to(profile(yc, 0)[:, None], (ny, nx + 1))
     t0 = time.perf_counter()
-    run(sim, t_end, [hist, nan])
+    if overset is None:
+        sim = Simulation(grid, cfg)
+        sim.bodies = [ImmersedBody(circle(d), Stationary(0.2, 0.2), grid, sim.L, order=ib_order)]
+        sim.set_state(u=u0)
+        hist, nan = ForceHistory(), NaNMonitor(every=200)
+        run(sim, t_end, [hist, nan])
+        t, f = hist.array()
+        f = f[:, 0, :]
+        probe, centre, cells, steps = sim, (0.2, 0.2), nx * ny, sim.n_steps
+    else:
+        body_grid = CartesianGrid.uniform(2 * ppd, 2 * ppd, (-d, d), (-d, d))
+        pair = OversetPair(grid, body_grid, cfg, Stationary(0.2, 0.2), polygon=circle(d))
+        pair.background.set_state(u=u0)
+        pair.set_initial_state()
+        t, f = [], []
+        while pair.t < t_end - 1e-12:
+            pair.step(min(pair.stable_dt(), t_end - pair.t))
+            t.append(pair.t)
+            f.append(pair.last_force)
+            if pair.n_steps % 200 == 0 and not np.isfinite(f[-1]).all():
+                raise FloatingPointError(f"DFG overset: non-finite force at t = {pair.t}")
+        t, f = np.array(t), np.array(f)
+        probe, centre = pair.body, (0.0, 0.0)
+        cells, steps = nx * ny + body_grid.nx * body_grid.ny, pair.n_steps
     wall = time.perf_counter() - t0
-    t, f = hist.array()
     um = 2 * umax / 3
     scale = 2 / (um ** 2 * d)
     last = t > t[-1] - 1.0
 
     def phi(x, y):
-        return np.hypot(x - 0.2, y - 0.2) - d / 2
+        return np.hypot(x - centre[0], y - centre[1]) - d / 2
 
-    dp, dp_linear = (_line_pressure(sim, 0.15, -1, 0.2, phi, n) - _line_pressure(sim, 0.25, +1, 0.2, phi, n)
-                     for n in (3, 2))
-    return {"case": "DFG 2D-1", "ppd": ppd, "cells": nx * ny, "nx": nx, "ny": ny, "t_end": float(sim.t),
-            "steps": sim.n_steps, "wall_s": wall, "blockage": d / h_ch, "advection": scheme, "ib_order": ib_order,
-            "ny_shift": ny_shift, "c_D": float(scale * f[-1, 0, 0]), "c_L": float(scale * f[-1, 0, 1]),
-            "dp": dp, "dp_linear": dp_linear,
-            "c_D_drift_per_time": float(np.polyfit(t[last] - t[-1], scale * f[last, 0, 0], 1)[0])
+    dp, dp_linear = (_line_pressure(probe, centre[0] - d / 2, -1, centre[1], phi, n)
+                     - _line_pressure(probe, centre[0] + d / 2, +1, centre[1], phi, n) for n in (3, 2))
+    return {"case": "DFG 2D-1", "ppd": ppd, "overset_background_ppd": overset, "cells": cells, "nx": nx, "ny": ny,
+            "t_end": float(t[-1]), "steps": steps, "wall_s": wall, "blockage": d / h_ch, "advection": scheme,
+            "ib_order": ib_order, "ny_shift": ny_shift, "c_D": float(scale * f[-1, 0]),
+            "c_L": float(scale * f[-1, 1]), "dp": dp, "dp_linear": dp_linear,
+            "c_D_drift_per_time": float(np.polyfit(t[last] - t[-1], scale * f[last, 0], 1)[0])
             if last.sum() > 2 else np.nan,
             "band": BANDS["dfg"]}
 
@@ -259,6 +282,8 @@ def main(argv=None):
     ap.add_argument("--ny-shift", type=int, nargs="+", default=[0],
                     help="dfg: extra cells across the channel (same h within a few %%, the cylinder cut "
                          "differently): shows how much of c_L depends on where the grid cuts the body")
+    ap.add_argument("--overset", type=int, default=None, metavar="BG_PPD",
+                    help="dfg: the cylinder in a body grid of h = D/ppd over a background of h = D/BG_PPD")
     ap.add_argument("--out", default="out/validation_cfd.jsonl")
     args = ap.parse_args(argv)
     wp.config.quiet = True
@@ -273,7 +298,7 @@ def main(argv=None):
                 r = cylinder(args.re, ppd, args.t_end, args.window, args.threads, args.advection,
                              *args.domain, ib_order=args.ib_order)
             else:
-                r = dfg(ppd, args.t_end, args.threads, args.advection, args.ib_order, variant)
+                r = dfg(ppd, args.t_end, args.threads, args.advection, args.ib_order, variant, args.overset)
             r["command"] = command
             _emit(r, args.out)
             results.append(r)
@@ -289,6 +314,9 @@ def _check_args(ap, args):
               ("--threads", args.threads, args.threads >= 1, ">= 1"),
               ("--domain", args.domain, min(args.domain[:2]) >= 1 and args.domain[2] > 1.5,
                "UPSTREAM, DOWNSTREAM >= 1 D and HALF_HEIGHT > 1.5 D (the refined band is +-1.5 D)")]
+    if args.overset is not None:
+        checks.append(("--overset", args.overset, args.overset >= 4 and args.case == "dfg",
+                       ">= 4 background cells per diameter, with the dfg case"))
     for name, value, ok, allowed in checks:
         if not ok:
             ap.error(f"{name}: {value} not allowed; allowed: {allowed}")

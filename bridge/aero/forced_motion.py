@@ -37,7 +37,7 @@ import numpy as np
 from bridge.errors import InputError, check_range
 
 __all__ = ["Quality", "QUALITY", "ForcedCase", "StaticCase", "ForceRecord", "run_case", "case_key",
-           "checkpoint_path", "whole_periods",
+           "checkpoint_path", "whole_periods", "preset", "GRIDS",
            "THESIS_HEAVE_RATE", "THESIS_PITCH_RATE"]
 
 THESIS_HEAVE_RATE = 0.4 / 50.0            # udot_0 / V (thesis 5.3)
@@ -63,6 +63,13 @@ class Quality:
     discard_periods: int = 2
     static_duration: float = 30.0   # a section held still: run length in convective times B / V
     settle_time: float = 16.0       # forced motion: at least this many B / V dropped before the fit
+    # overset grids (bridge.cfd.overset): the section in a body grid of this preset's spacing (dx, and
+    # dy = dy_over_dx dx) reaching ``body_margin`` chords (at least 6 background cells) beyond it, over a
+    # background whose cells are
+    # ``background_coarsening`` times larger; False: one grid, the section an immersed body moving on it
+    overset: bool = False
+    background_coarsening: int = 2
+    body_margin: float = 0.35
 
     def __post_init__(self):
         check_range("aero.cells_per_chord", self.cells_per_chord, 8, 2000)
@@ -70,6 +77,8 @@ class Quality:
         check_range("aero.reynolds", self.reynolds, 1.0, 1e6)
         check_range("aero.static_duration", self.static_duration, 1.0, 1e4)
         check_range("aero.settle_time", self.settle_time, 0.0, 1e4)
+        check_range("aero.background_coarsening", self.background_coarsening, 1, 16)
+        check_range("aero.body_margin", self.body_margin, 0.05, 5.0)
         if not (0 < self.discard_periods < self.periods):
             raise InputError("aero.discard_periods", self.discard_periods,
                              f"must be >= 1 and below periods ({self.periods})")
@@ -87,6 +96,18 @@ QUALITY = {
     "fine": Quality("fine", 80, 0.25, 3.0, 20.0, 3.0, 0.2, 2000.0, periods=5, discard_periods=2,
                     static_duration=40.0),
 }
+
+
+GRIDS = ("single", "overset")
+
+
+def preset(quality: str, grid: str = "single") -> Quality:
+    """The quality preset ``quality`` on one grid ("single") or on the overset pair ("overset")."""
+    from dataclasses import replace
+
+    if grid not in GRIDS:
+        raise InputError("aero.grid", grid, f"one of {', '.join(GRIDS)}")
+    return replace(QUALITY[quality], overset=grid == "overset")
 
 
 @dataclass(frozen=True)
@@ -274,7 +295,7 @@ def checkpoint_path(runs: Path | None, shape, case, q: Quality) -> Path | None:
     return None if runs is None else Path(runs) / f"{case_key(shape, case, q)[:24]}.h5"
 
 
-def _save_checkpoint(path: Path, key: str, sim, rec: dict) -> None:
+def _save_checkpoint(path: Path, key: str, flow, rec: dict) -> None:
     import h5py
 
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
@@ -282,10 +303,10 @@ def _save_checkpoint(path: Path, key: str, sim, rec: dict) -> None:
     try:
         with h5py.File(tmp, "w") as h5:
             h5.attrs["case_key"] = key
-            h5.attrs["t"] = sim.t
-            h5.attrs["n_steps"] = sim.n_steps
-            for name in ("u", "v", "p"):
-                h5.create_dataset(name, data=getattr(sim, name).numpy())
+            h5.attrs["t"] = flow.t
+            h5.attrs["n_steps"] = flow.n_steps
+            for name, values in flow.checkpoint_arrays().items():
+                h5.create_dataset(f"state/{name}", data=values)
             for name, values in rec.items():
                 h5.create_dataset(f"record/{name}", data=np.asarray(values))
         os.replace(tmp, path)
@@ -294,7 +315,7 @@ def _save_checkpoint(path: Path, key: str, sim, rec: dict) -> None:
         raise
 
 
-def _load_checkpoint(path: Path, key: str, sim) -> dict | None:
+def _load_checkpoint(path: Path, key: str, flow) -> dict | None:
     import h5py
 
     if not path.is_file():
@@ -303,10 +324,10 @@ def _load_checkpoint(path: Path, key: str, sim) -> dict | None:
         with h5py.File(path, "r") as h5:
             if h5.attrs.get("case_key") != key:
                 return None
-            for name in ("u", "v", "p"):
-                getattr(sim, name).assign(h5[name][()])
-            sim.t = float(h5.attrs["t"])
-            sim.n_steps = int(h5.attrs["n_steps"])
+            arrays = {}
+            h5["state"].visititems(lambda name, obj: arrays.__setitem__(name, obj[()])
+                                   if isinstance(obj, h5py.Dataset) else None)
+            flow.restore_arrays(arrays, float(h5.attrs["t"]), int(h5.attrs["n_steps"]))
             return {name: list(h5[f"record/{name}"][()]) for name in h5["record"]}
     except (OSError, KeyError, ValueError):   # unreadable or of another grid: start afresh
         return None
@@ -322,19 +343,11 @@ def run_case(shape, case: ForcedCase | StaticCase, quality: Quality, checkpoint:
     ``checkpoint`` if it holds this case (:func:`case_key`); progress lines about every 10 % of the run.
     ``threads``: CPU threads of the step (default 2, but 1 below 20 000 cells, where waiting for the second thread
     costs more than it saves; the numbers do not depend on it)."""
-    from bridge.cfd import BoundaryConditions, FlowConfig, NaNMonitor, Simulation
+    from bridge.cfd import NaNMonitor
 
     q = quality
     polys = _polygons(shape)
-    radius = max(p.radius for p in polys)
-    grid = _grid(q, max(float(np.abs(p.vertices[:, 1]).max()) for p in polys) + case.excursion(radius))
-    bc = BoundaryConditions(left="inflow", right="outflow", bottom="slip", top="slip")
-    if threads is None:
-        threads = 1 if grid.nx * grid.ny < 20_000 else 2
-    sim = Simulation(grid, FlowConfig(nu=1.0 / q.reynolds, advection="vanleer", cfl=q.cfl, threads=threads, bc=bc))
-    for p in polys:
-        sim.add_body(p, case.motion())
-    sim.set_state(u=1.0)
+    flow = _OversetFlow(q, polys, case, threads) if q.overset else _SingleGridFlow(q, polys, case, threads)
     key = case_key(polys, case, q)
     names = ("t", "lift", "drag", "moment", "motion")
     rec = {n: [] for n in names}
@@ -342,42 +355,147 @@ def run_case(shape, case: ForcedCase | StaticCase, quality: Quality, checkpoint:
     if checkpoint is not None:
         checkpoint = Path(checkpoint)
         checkpoint.parent.mkdir(parents=True, exist_ok=True)
-        got = _load_checkpoint(checkpoint, key, sim)
+        got = _load_checkpoint(checkpoint, key, flow)
         if got is not None:
             rec = {n: list(got.get(n, [])) for n in names}
-            resumed = sim.n_steps
+            resumed = flow.n_steps
             if progress:
-                progress(f"{label}: resuming at t = {sim.t:.2f} (step {resumed}) from {checkpoint}")
+                progress(f"{label}: resuming at t = {flow.t:.2f} (step {resumed}) from {checkpoint}")
     t_end = case.end_time(q)
-    nan = NaNMonitor(every=200)
-    t0, t_start = time.perf_counter(), sim.t
-    next_note = sim.t + 0.1 * t_end
-    while sim.t < t_end - 1e-12 * t_end:
-        sim.step(sim.stable_dt())
-        fx, fy, mz = np.sum(sim.last_force, axis=0)   # all parts about the same reference point
-        rec["t"].append(sim.t)
+    nans = [NaNMonitor(every=200) for _ in flow.simulations]
+    t0, t_start = time.perf_counter(), flow.t
+    next_note = flow.t + 0.1 * t_end
+    while flow.t < t_end - 1e-12 * t_end:
+        flow.step(flow.stable_dt())
+        fx, fy, mz = flow.last_force   # all parts about the same reference point
+        rec["t"].append(flow.t)
         rec["lift"].append(fy)
         rec["drag"].append(fx)
         rec["moment"].append(-mz)
-        rec["motion"].append(case.displacement(sim.t))
-        nan(sim)
-        if checkpoint is not None and sim.n_steps % checkpoint_every == 0:
-            _save_checkpoint(checkpoint, key, sim, rec)
-        if progress and sim.t >= next_note:
-            done = sim.t / t_end
-            left = (time.perf_counter() - t0) / max(sim.t - t_start, 1e-12) * max(t_end - sim.t, 0.0)
-            progress(f"{label}: t = {sim.t:.1f} of {t_end:.1f} ({100 * done:.0f} %, "
-                     f"{case.progress(sim.t, q)}), {grid.nx} x {grid.ny} cells, about {left:.0f} s left")
+        rec["motion"].append(case.displacement(flow.t))
+        for nan, sim in zip(nans, flow.simulations, strict=True):
+            nan(sim)
+        if checkpoint is not None and flow.n_steps % checkpoint_every == 0:
+            _save_checkpoint(checkpoint, key, flow, rec)
+        if progress and flow.t >= next_note:
+            done = flow.t / t_end
+            left = (time.perf_counter() - t0) / max(flow.t - t_start, 1e-12) * max(t_end - flow.t, 0.0)
+            progress(f"{label}: t = {flow.t:.1f} of {t_end:.1f} ({100 * done:.0f} %, "
+                     f"{case.progress(flow.t, q)}), {flow.describe()}, about {left:.0f} s left")
             next_note += 0.1 * t_end
     if checkpoint is not None:
-        _save_checkpoint(checkpoint, key, sim, rec)
+        _save_checkpoint(checkpoint, key, flow, rec)
     arrays = {n: np.asarray(v, dtype=np.float64) for n, v in rec.items()}
     from bridge.aero.snapshots import flow_snapshot
 
+    sim = flow.simulations[0]   # the fixed grid (overset: the background, which holds the body grid's flow
+    grid = sim.grid             # at its own resolution in the hole)
     snap = flow_snapshot(grid, sim.u.numpy(), sim.v.numpy(), sim.p.numpy(), polys, case.motion().pose(sim.t), sim.t)
-    return ForceRecord(**arrays, steps=sim.n_steps, wall_s=time.perf_counter() - t0, resumed_from_step=resumed,
-                       meta={"nx": grid.nx, "ny": grid.ny, "reynolds": q.reynolds, "quality": q.name,
-                             **asdict(case)}, snapshot=snap)
+    return ForceRecord(**arrays, steps=flow.n_steps, wall_s=time.perf_counter() - t0, resumed_from_step=resumed,
+                       meta={"nx": grid.nx, "ny": grid.ny, "cells": flow.n_cells, "grids": flow.describe(),
+                             "reynolds": q.reynolds, "quality": q.name, **asdict(case)}, snapshot=snap)
+
+
+class _SingleGridFlow:
+    """One grid, the section an immersed body moving on it."""
+
+    def __init__(self, q: Quality, polys, case, threads):
+        from bridge.cfd import BoundaryConditions, FlowConfig, Simulation
+
+        radius = max(p.radius for p in polys)
+        grid = _grid(q, max(float(np.abs(p.vertices[:, 1]).max()) for p in polys) + case.excursion(radius))
+        bc = BoundaryConditions(left="inflow", right="outflow", bottom="slip", top="slip")
+        if threads is None:
+            threads = 1 if grid.nx * grid.ny < 20_000 else 2
+        self.sim = Simulation(grid, FlowConfig(nu=1.0 / q.reynolds, advection="vanleer", cfl=q.cfl, threads=threads,
+                                               bc=bc))
+        for p in polys:
+            self.sim.add_body(p, case.motion())
+        self.sim.set_state(u=1.0)
+        self.simulations = [self.sim]
+        self.n_cells = grid.nx * grid.ny
+
+    t = property(lambda self: self.sim.t)
+    n_steps = property(lambda self: self.sim.n_steps)
+    last_force = property(lambda self: np.sum(self.sim.last_force, axis=0))
+
+    def step(self, dt):
+        return self.sim.step(dt)
+
+    def stable_dt(self):
+        return self.sim.stable_dt()
+
+    def describe(self) -> str:
+        return f"{self.sim.grid.nx} x {self.sim.grid.ny} cells"
+
+    def checkpoint_arrays(self) -> dict:
+        return {name: getattr(self.sim, name).numpy() for name in ("u", "v", "p")}
+
+    def restore_arrays(self, arrays: dict, t: float, n_steps: int) -> None:
+        for name in ("u", "v", "p"):
+            getattr(self.sim, name).assign(arrays[name])
+        self.sim.t, self.sim.n_steps = t, n_steps
+
+
+class _OversetFlow(_SingleGridFlow):
+    """The section in a body grid that moves with it over a coarser fixed background
+    (``bridge.cfd.OversetPair``; ``Quality.overset``)."""
+
+    def __init__(self, q: Quality, polys, case, threads):
+        from bridge.cfd import BoundaryConditions, CartesianGrid, FlowConfig, OversetPair, stretched_faces
+
+        h = 1.0 / q.cells_per_chord
+        dy = q.dy_over_dx * h
+        xs = np.concatenate([p.vertices[:, 0] for p in polys])
+        ys = np.concatenate([p.vertices[:, 1] for p in polys])
+        H = q.background_coarsening * h
+        m = max(q.body_margin, 6 * H)   # the hole (4 background cells inside the body grid) covers the body
+        nbx = int(np.ceil((xs.max() - xs.min() + 2 * m) / h))
+        nby = int(np.ceil((ys.max() - ys.min() + 2 * m) / dy))
+        cx, cy = 0.5 * (xs.max() + xs.min()), 0.5 * (ys.max() + ys.min())
+        body = CartesianGrid.uniform(nbx, nby, (cx - 0.5 * nbx * h, cx + 0.5 * nbx * h),
+                                     (cy - 0.5 * nby * dy, cy + 0.5 * nby * dy))
+        # background: the preset's grid with cells background_coarsening times larger, its uniform core
+        # holding the body grid wherever the motion takes it
+        up = max(q.upstream, -body.x_faces[0] + 8 * H)   # the fringe stays clear of the in- and outflow
+        down = max(q.downstream, body.x_faces[-1] + 8 * H)
+        nx = int(round((up + down) / H))
+        x = np.linspace(-up, down, nx + 1)
+        corners = np.array([[body.x_faces[i], body.y_faces[j]] for i in (0, -1) for j in (0, -1)])
+        reach = float(np.abs(corners[:, 1]).max()) + case.excursion(float(np.hypot(*corners.T).max()))
+        core = max(q.core_half_height, reach + 4 * H)
+        half = max(q.half_height, core + 8 * H)   # the body grid's fringe stays clear of the sides
+        y = stretched_faces(-half, half, (-core, core), q.dy_over_dx * H, q.stretch)
+        background = CartesianGrid(x, y)
+        if threads is None:
+            threads = 1 if background.nx * background.ny < 20_000 else 2
+        bc = BoundaryConditions(left="inflow", right="outflow", bottom="slip", top="slip")
+        config = FlowConfig(nu=1.0 / q.reynolds, advection="vanleer", cfl=q.cfl, threads=threads, bc=bc)
+        self.pair = OversetPair(background, body, config, case.motion(), polygon=polys)
+        self.pair.set_uniform_flow(1.0)
+        self.simulations = [self.pair.background, self.pair.body]
+        self.n_cells = self.pair.n_cells
+        self.sim = self.pair.background
+
+    t = property(lambda self: self.pair.t)
+    n_steps = property(lambda self: self.pair.n_steps)
+    last_force = property(lambda self: self.pair.last_force)
+
+    def step(self, dt):
+        return self.pair.step(dt)
+
+    def stable_dt(self):
+        return self.pair.stable_dt()
+
+    def describe(self) -> str:
+        b, g = self.pair.background.grid, self.pair.body.grid
+        return f"{b.nx} x {b.ny} + body {g.nx} x {g.ny} cells"
+
+    def checkpoint_arrays(self) -> dict:
+        return self.pair.checkpoint_arrays()
+
+    def restore_arrays(self, arrays: dict, t: float, n_steps: int) -> None:
+        self.pair.restore_arrays(arrays, t, n_steps)
 
 
 def whole_periods(record: ForceRecord, case: ForcedCase, q: Quality) -> np.ndarray:

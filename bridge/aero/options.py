@@ -14,6 +14,9 @@ Keys (all optional):
                           heave and one pitch run moving at all of them at once (a sum of sines,
                           bridge.aero.forced_motion.ForcedCase.multi_frequency); the reduced velocities must
                           then be the largest one over whole numbers (e.g. 16, 8, 5.333, 4)
+    grid                  "single": one grid, the section an immersed body moving on it (default); "overset":
+                          the section in a fine grid that moves with it over a coarser fixed background
+                          (bridge/cfd/overset.py; no face of the body changes class as it moves)
     static_angles_deg     angles of attack (degrees, nose-up) at which the section is held still for its
                           static coefficients C_D, C_L, C_M, their slopes and the Strouhal number
                           (default -2, 0, 2; [] skips them); with aerodynamics = "cfd" they supply the
@@ -42,9 +45,13 @@ class AeroOptions:
     checkpoint_every: int = 2000
     static_angles_deg: tuple[float, ...] = (-2.0, 0.0, 2.0)
     excitation: str = "single"
+    grid: str = "single"
 
     def __post_init__(self):
-        from bridge.aero.forced_motion import QUALITY
+        from bridge.aero.forced_motion import GRIDS, QUALITY
+
+        if self.grid not in GRIDS:
+            raise InputError("aero.grid", self.grid, f"one of {', '.join(GRIDS)}")
 
         if self.quality not in QUALITY:
             raise InputError("aero.quality", self.quality, f"one of {', '.join(QUALITY)}")

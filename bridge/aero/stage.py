@@ -24,7 +24,14 @@ from typing import Any
 
 import numpy as np
 
-from bridge.aero.forced_motion import QUALITY, ForcedCase, StaticCase, checkpoint_path, run_case, whole_periods
+from bridge.aero.forced_motion import (
+    ForcedCase,
+    StaticCase,
+    checkpoint_path,
+    preset,
+    run_case,
+    whole_periods,
+)
 from bridge.aero.frequency_response import forced_motion_response
 from bridge.aero.options import AeroOptions
 from bridge.aero.snapshots import snapshot_files
@@ -83,7 +90,7 @@ def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
     section = getattr(scenario, "deck_section", None) or great_belt_section()
     aopts: AeroOptions = getattr(scenario, "aero", None) or AeroOptions()
     quality = options.quality or ("tiny" if options.quick else aopts.quality)
-    q = QUALITY[quality]
+    q = preset(quality, aopts.grid)
     poly = _unit_polygons(section)
     cells_across = (section.depth_m / section.chord_m) * q.cells_per_chord / q.dy_over_dx
     warning = ("" if cells_across >= 2.0 else
@@ -94,7 +101,7 @@ def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
     Ks = np.array(sorted(2 * np.pi / np.asarray(aopts.reduced_velocities)))
     runs = options.cache / "aero-runs" if options.cache is not None else None
     options.say(f"aero: {section.describe()}; {len(Ks)} reduced frequencies x heave and pitch on the "
-                f"{quality!r} preset (Re = {q.reynolds:g}, laminar)")
+                f"{quality!r} preset ({aopts.grid} grid, Re = {q.reynolds:g}, laminar)")
     values = {n: np.zeros(len(Ks), dtype=complex) for n in VERTICAL_TORSIONAL + ("h_qu", "h_qtheta")}
     errors = {n: np.zeros(len(Ks), dtype=complex) for n in values}
     records, cells = [], (0, 0)

@@ -167,8 +167,9 @@ class _Fringe(StageHook):
         J, I = np.meshgrid(j, i, indexing="ij")
         band = (I <= 0) | (I >= nx) | (J <= 0) | (J >= ny)
         self.band = band
+        self.dy = float(gb.dy[0])
         self.xi = gb.x_faces[0] + I[band] * gb.dx
-        self.eta = gb.y_faces[0] + J[band] * float(gb.dy[0])
+        self.eta = gb.y_faces[0] + J[band] * self.dy
         self.psi = np.zeros(band.shape)
         # fringe faces in storage: u (ny+2g, nx+1+2g), v (ny+1+2g, nx+2g); i, j as above
         ju, iu = np.meshgrid(np.arange(-g, ny + g), np.arange(-g, nx + g + 1), indexing="ij")
@@ -184,9 +185,8 @@ class _Fringe(StageHook):
     def _faces(self, t_new):
         if self._t != t_new:
             self.psi[self.band] = self.pair.background_psi_at(self.xi, self.eta, t_new)
-            gb = self.pair.body.grid
-            self.fu = (self.psi[1:, :] - self.psi[:-1, :]) / float(gb.dy[0])
-            self.fv = -(self.psi[:, 1:] - self.psi[:, :-1]) / gb.dx
+            self.fu = (self.psi[1:, :] - self.psi[:-1, :]) / self.dy
+            self.fv = -(self.psi[:, 1:] - self.psi[:, :-1]) / self.pair.body.grid.dx
             self._t = t_new
         return self.fu, self.fv
 
@@ -236,14 +236,15 @@ class OversetPair:
 
     ``body_grid``: uniform ``CartesianGrid`` in the body's coordinates (the reference point at 0);
     ``motion``: the body's rigid motion (pose(t), velocity(t)); ``polygon``: the body in its own
-    coordinates (None: a body grid with no body, for the freestream and frame checks);
+    coordinates, or a list of polygons moving together (a deck with railings; the force is their
+    sum), or None: a body grid with no body (the freestream and frame checks);
     ``overlap``: how far inside the body grid's rectangle the hole starts, in background cells.
     """
 
     def __init__(self, background_grid: CartesianGrid, body_grid: CartesianGrid, config: FlowConfig,
                  motion, polygon: Polygon | None = None, overlap: float = 4.0, device: str | None = None):
-        if not body_grid.y_uniform or not math.isclose(float(body_grid.dy[0]), body_grid.dx, rel_tol=1e-9):
-            raise ValueError("body_grid: must be uniform with square cells")
+        if not body_grid.y_uniform:
+            raise ValueError("body_grid: y spacing must be uniform (x always is)")
         if overlap < 3:
             raise ValueError(f"overlap: must be >= 3 background cells, got {overlap}")
         self.motion, self.config, self.overlap = motion, config, float(overlap)
@@ -253,22 +254,33 @@ class OversetPair:
         body_config = FlowConfig(**{**{f: getattr(config, f) for f in config.__dataclass_fields__},
                                     "bc": BoundaryConditions(left="slip", right="slip")})
         self.body = Simulation(body_grid, body_config, device=device)
-        self.immersed = None
-        if polygon is not None:
-            self.immersed = _FrameBody(polygon, motion, body_grid, self.body.L)
-            self.body.bodies.append(self.immersed)
+        polygons = [] if polygon is None else list(polygon) if isinstance(polygon, (list, tuple)) else [polygon]
+        for poly in polygons:
+            self.body.bodies.append(_FrameBody(poly, motion, body_grid, self.body.L))
             self.body.last_force.append(np.zeros(3))
         gbg, gb = background_grid, body_grid
         self._bg_interp_x = gbg.x_faces
         self._body_interp = CornerInterpolator(gb.x_faces, gb.y_faces)
-        h_bg = min(gbg.dx, float(np.min(gbg.dy)))
-        h_max = max(gbg.dx, float(np.max(gbg.dy)))
+        # the background's largest spacing where the body grid is (its initial place, any rotation: within
+        # its half-diagonal of its centre): the hole starts ``overlap`` such cells inside the body grid
+        reach = 0.5 * math.hypot(gb.x_faces[-1] - gb.x_faces[0], gb.y_faces[-1] - gb.y_faces[0])
+        xc, yc = self.to_background(np.array([0.5 * (gb.x_faces[0] + gb.x_faces[-1])]),
+                                    np.array([0.5 * (gb.y_faces[0] + gb.y_faces[-1])]), 0.0)
+        near = (gbg.y_faces[1:] > yc[0] - reach) & (gbg.y_faces[:-1] < yc[0] + reach)
+        h_max = max(gbg.dx, float(np.max(gbg.dy[near])) if near.any() else float(np.max(gbg.dy)))
         inset = self.overlap * h_max
         self.hole = (gb.x_faces[0] + inset, gb.x_faces[-1] - inset, gb.y_faces[0] + inset, gb.y_faces[-1] - inset)
         if self.hole[0] >= self.hole[1] or self.hole[2] >= self.hole[3]:
             raise ValueError(f"body_grid: too small for an overlap of {overlap} background cells "
                              f"(h = {h_max:.4g}): no hole left")
-        self.h_background = h_bg
+        for poly in polygons:
+            v = poly.vertices
+            if v[:, 0].min() < self.hole[0] or v[:, 0].max() > self.hole[1] or v[:, 1].min() < self.hole[2] \
+                    or v[:, 1].max() > self.hole[3]:
+                hole = tuple(round(float(h), 4) for h in self.hole)
+                raise ValueError(f"body_grid: the hole {hole} (the body grid less {overlap} background cells) must "
+                                 "cover the body; enlarge the body grid")
+        self.h_background = h_max
         self._fringe = _Fringe(self)
         self._hole = _Hole(self)
         self.body.hooks.append(self._fringe)
@@ -282,13 +294,24 @@ class OversetPair:
     def set_uniform_flow(self, u_inf: float, t: float = 0.0) -> None:
         """Both grids at rest in a uniform stream (u_inf, 0) (the body grid: in its own axes)."""
         self.background.set_state(u=u_inf, v=0.0, t=t)
-        theta = self.motion.pose(t)[2]
-        ub, vb = _rotation(theta).T @ np.array([u_inf, 0.0])
-        self.body.set_state(u=float(ub), v=float(vb), t=t)
-        self.t = float(t)
-        self._bg_psi = None
+        self.set_initial_state()
+
+    def set_initial_state(self) -> None:
+        """The body grid's whole state from the background's (set first, e.g. by
+        ``background.set_state``) at the background's time: every face from the background's stream
+        function at the body grid's corners, so the two agree and the body grid starts
+        divergence-free; the immersed body takes over at the first step."""
+        g, gb = GHOST, self.body.grid
+        t = self.background.t
+        i = np.arange(-g, gb.nx + g + 1)
+        j = np.arange(-g, gb.ny + g + 1)
+        dy = float(gb.dy[0])
+        xi, eta = np.meshgrid(gb.x_faces[0] + i * gb.dx, gb.y_faces[0] + j * dy)
+        psi = self.background_psi_at(xi.ravel(), eta.ravel(), t).reshape(xi.shape)
+        self.body.u.assign((psi[1:, :] - psi[:-1, :]) / dy)
+        self.body.v.assign(-(psi[:, 1:] - psi[:, :-1]) / gb.dx)
+        self.body.t = self.t = t
         self._fringe._t = None
-        self._fringe.after_projection(self.body, 0, self.body.u, self.body.v, t)
         self._psi_hist = [(self.t, stream_function(self.body))]
 
     # --- frames -------------------------------------------------------------------------------
@@ -385,5 +408,31 @@ class OversetPair:
 
     @property
     def last_force(self) -> np.ndarray:
-        """(F_x, F_y, M_z) on the body over the last step, inertial axes (zeros without a body)."""
-        return self.body.last_force[0] if self.immersed is not None else np.zeros(3)
+        """(F_x, F_y, M_z) on the body (all its polygons) over the last step, inertial axes, M_z about
+        the body's reference point (zeros without a body)."""
+        return np.sum(self.body.last_force, axis=0) if self.body.bodies else np.zeros(3)
+
+    @property
+    def n_cells(self) -> int:
+        return self.background.grid.nx * self.background.grid.ny + self.body.grid.nx * self.body.grid.ny
+
+    # --- checkpoint ---------------------------------------------------------------------------
+    def checkpoint_arrays(self) -> dict[str, np.ndarray]:
+        """Everything a restart needs (with ``t`` and ``n_steps``): both grids' u, v, p and the body
+        grid's stream function of the last two steps (the hole's extrapolation)."""
+        out = {f"{name}/{f}": getattr(sim, f).numpy().copy() for name, sim in (("background", self.background),
+                                                                             ("body", self.body)) for f in "uvp"}
+        out["psi_times"] = np.array([t for t, _ in self._psi_hist])
+        for k, (_, psi) in enumerate(self._psi_hist):
+            out[f"psi_{k}"] = psi
+        return out
+
+    def restore_arrays(self, arrays: dict[str, np.ndarray], t: float, n_steps: int) -> None:
+        for name, sim in (("background", self.background), ("body", self.body)):
+            for f in "uvp":
+                getattr(sim, f).assign(arrays[f"{name}/{f}"])
+            sim.t, sim.n_steps = float(t), int(n_steps)
+        self.t, self.n_steps = float(t), int(n_steps)
+        times = np.atleast_1d(arrays["psi_times"])
+        self._psi_hist = [(float(tk), np.asarray(arrays[f"psi_{k}"])) for k, tk in enumerate(times)]
+        self._fringe._t = None

@@ -6,7 +6,7 @@ validation against Theodorsen and its status)."""
 import numpy as np
 import pytest
 
-from bridge.aero.forced_motion import QUALITY, ForcedCase, run_case
+from bridge.aero.forced_motion import QUALITY, ForcedCase, preset, run_case
 from bridge.aero.stage import _unit_polygon
 from bridge.cfd.sections import Rectangle
 
@@ -15,10 +15,13 @@ class Killed(Exception):
     pass
 
 
-def test_a_killed_case_resumes_from_its_checkpoint_and_ends_with_the_same_numbers(tmp_path):
+@pytest.mark.parametrize("grid", ["single", pytest.param("overset", marks=pytest.mark.slow)])  # overset ~20 s
+def test_a_killed_case_resumes_from_its_checkpoint_and_ends_with_the_same_numbers(tmp_path, grid):
+    """Bit for bit: the checkpoint holds all the state (overset: both grids and the body grid's stream
+    function of the last two steps, which the hole extrapolates)."""
     poly = _unit_polygon(Rectangle(10.0, 2.0))
     case = ForcedCase("heave", (2.5,), (0.005,))
-    q = QUALITY["tiny"]
+    q = preset("tiny", grid)
     whole = run_case(poly, case, q)
     ckpt = tmp_path / "case.h5"
     calls = []
