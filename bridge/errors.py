@@ -30,6 +30,14 @@ class ConvergenceError(RuntimeError):
         )
 
 
+class DivergedError(ConvergenceError):
+    """A time-marching solution that stopped being finite (the CFD): ``what`` and where/when."""
+
+    def __init__(self, what: str, detail: str):
+        self.what, self.iterations, self.residual, self.tolerance = what, 0, float("inf"), 0.0
+        RuntimeError.__init__(self, f"{what} diverged: {detail}")
+
+
 def check_range(key: str, value: float, low: float | None = None, high: float | None = None,
                 low_open: bool = False, high_open: bool = False) -> float:
     """Return ``float(value)`` if it is finite and lies in the range, else raise :class:`InputError` naming it.

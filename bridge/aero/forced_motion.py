@@ -34,7 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
-from bridge.errors import InputError, check_range
+from bridge.errors import DivergedError, InputError, check_range
 
 __all__ = ["Quality", "QUALITY", "ForcedCase", "StaticCase", "ForceRecord", "run_case", "case_key",
            "checkpoint_path", "whole_periods", "preset", "GRIDS",
@@ -342,12 +342,27 @@ def run_case(shape, case: ForcedCase | StaticCase, quality: Quality, checkpoint:
     or a list of polygons moving together (a box with railings); the loads are their sum.  Resumes from
     ``checkpoint`` if it holds this case (:func:`case_key`); progress lines about every 10 % of the run.
     ``threads``: CPU threads of the step (default 2, but 1 below 20 000 cells, where waiting for the second thread
-    costs more than it saves; the numbers do not depend on it)."""
-    from bridge.cfd import NaNMonitor
+    costs more than it saves; the numbers do not depend on it).  A run whose flow stops being finite
+    raises DivergedError (exit status 3); a section the preset's grid cannot hold, InputError (2)."""
+    from bridge.cfd import FlowDiverged
 
     q = quality
     polys = _polygons(shape)
-    flow = _OversetFlow(q, polys, case, threads) if q.overset else _SingleGridFlow(q, polys, case, threads)
+    try:
+        flow = _OversetFlow(q, polys, case, threads) if q.overset else _SingleGridFlow(q, polys, case, threads)
+    except ValueError as err:   # the section and the preset's grid do not fit together
+        raise InputError("aero.quality", q.name, f"its {'overset' if q.overset else 'single'} grid cannot hold "
+                         f"this section and motion ({err})") from None
+    try:
+        return _march(flow, polys, case, q, checkpoint, checkpoint_every, progress, label)
+    except FlowDiverged as err:
+        raise DivergedError(f"the CFD of {label or case}", str(err)) from None
+
+
+def _march(flow, polys, case, q, checkpoint, checkpoint_every, progress, label) -> ForceRecord:
+    """Run ``flow`` to the case's end time, with checkpoints and progress (run_case)."""
+    from bridge.cfd import NaNMonitor
+
     key = case_key(polys, case, q)
     names = ("t", "lift", "drag", "moment", "motion")
     rec = {n: [] for n in names}
