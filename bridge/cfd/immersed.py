@@ -63,11 +63,12 @@ __all__ = ["ImmersedBody"]
 class ImmersedBody:
     """A rigid polygon on a grid: classifies faces, applies the forcing, returns forces.
 
-    ``apply`` mutates the predicted velocity in place. ``margin`` cells surround the body's box.
+    ``apply`` mutates the predicted velocity in place. ``margin`` cells surround the body's box;
+    ``stages``: of the time scheme (the forcing impulse is kept per stage).
     """
 
     def __init__(self, polygon: Polygon, motion, grid: CartesianGrid, launcher, margin: int = 3,
-                 order: int = 1):
+                 order: int = 1, stages: int = 2):
         if margin < 2:
             raise ValueError(f"margin: must be >= 2 cells, got {margin}")
         if order not in (1, 2):
@@ -77,7 +78,7 @@ class ImmersedBody:
         dev = launcher.device
         self.margin = margin
         self.verts = wp.array(polygon.vertices, dtype=wp.vec2d, device=dev)
-        self.acc = wp.zeros(6, dtype=WP_DTYPE, device=dev)
+        self.acc = wp.zeros(3 * stages, dtype=WP_DTYPE, device=dev)   # (F_x, F_y, M_z) impulse per stage
         g = GHOST
         self.yc_u = wp.array(grid.storage_y_centres(), dtype=WP_DTYPE, device=dev)
         self.yc_v = wp.array(grid.storage_y_faces(), dtype=WP_DTYPE, device=dev)

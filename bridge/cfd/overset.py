@@ -130,8 +130,8 @@ class _FrameMotion:
 class _FrameBody(ImmersedBody):
     """The immersed body fixed in the body grid; its force in the inertial frame (module doc)."""
 
-    def __init__(self, polygon, motion, grid, launcher, margin=3):
-        super().__init__(polygon, _FrameMotion(motion), grid, launcher, margin)
+    def __init__(self, polygon, motion, grid, launcher, margin=3, stages=2):
+        super().__init__(polygon, _FrameMotion(motion), grid, launcher, margin, stages=stages)
         self.inertial = motion
 
     def _centroid_inertial(self, t):
@@ -256,7 +256,7 @@ class OversetPair:
         self.body = Simulation(body_grid, body_config, device=device)
         polygons = [] if polygon is None else list(polygon) if isinstance(polygon, (list, tuple)) else [polygon]
         for poly in polygons:
-            self.body.bodies.append(_FrameBody(poly, motion, body_grid, self.body.L))
+            self.body.bodies.append(_FrameBody(poly, motion, body_grid, self.body.L, stages=len(self.body.stages)))
             self.body.last_force.append(np.zeros(3))
         gbg, gb = background_grid, body_grid
         self._bg_interp_x = gbg.x_faces

@@ -158,7 +158,7 @@ class Simulation:
         """Immerse a rigid polygon moving with ``motion``; returns the ``ImmersedBody``."""
         from .immersed import ImmersedBody
 
-        body = ImmersedBody(polygon, motion, self.grid, self.L, margin)
+        body = ImmersedBody(polygon, motion, self.grid, self.L, margin, stages=len(self.stages))
         self.bodies.append(body)
         self.last_force.append(np.zeros(3))
         return body

@@ -272,3 +272,17 @@ def test_forced_cells_are_the_cells_touching_forced_faces():
     assert forced[dist < 0.5 * h].all()
     assert not forced[dist > 1.51 * h].any()
     assert 0 < forced.sum() < forced.size
+
+
+def test_forcing_impulse_is_kept_per_stage_of_the_time_scheme():
+    """The body's impulse buffer is sized from the time scheme, not assumed (was: two stages)."""
+    from bridge.cfd import TIME_SCHEMES
+
+    grid = CartesianGrid.uniform(16, 16, (-2.0, 2.0), (-2.0, 2.0))
+    for name, stages in TIME_SCHEMES.items():
+        sim = Simulation(grid, FlowConfig(nu=0.1, time_scheme=name))
+        body = sim.add_body(circle(1.0), Stationary())
+        assert body.acc.shape == (3 * len(stages),), name
+        sim.set_state(u=1.0)
+        sim.step(0.01)
+        assert np.isfinite(sim.last_force[0]).all()
