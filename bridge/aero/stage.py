@@ -53,7 +53,7 @@ class AeroResult:
     section: str
     quality: str
     reynolds: float
-    cells: tuple[int, int]
+    cells: int                         # cells of the forced-motion runs (both grids of an overset pair)
     reduced_frequency: np.ndarray      # K = w B / V, ascending
     frf: FRF                           # arrays over K (vertical-torsional; drag terms when recorded)
     stderr: FRF
@@ -62,6 +62,8 @@ class AeroResult:
     warning: str = ""                  # e.g. the section under-resolved on this preset
     static: StaticCoefficients | None = None
     static_records: tuple[dict, ...] = ()   # per static case: angle_deg, steps, wall_s, t, lift, drag, moment
+    grid: str = "single"               # [aero] grid: "single" or "overset"
+    grids: str = ""                    # the grids in words, e.g. "480 x 144 cells"
 
     @property
     def reduced_velocity(self) -> np.ndarray:
@@ -104,7 +106,7 @@ def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
                 f"{quality!r} preset ({aopts.grid} grid, Re = {q.reynolds:g}, laminar)")
     values = {n: np.zeros(len(Ks), dtype=complex) for n in VERTICAL_TORSIONAL + ("h_qu", "h_qtheta")}
     errors = {n: np.zeros(len(Ks), dtype=complex) for n in values}
-    records, cells = [], (0, 0)
+    records, cells, grids = [], 0, ""
     cases = _forced_cases(Ks, aopts)
     for n, case in enumerate(cases):
         ks = case.reduced_frequencies
@@ -125,7 +127,7 @@ def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
                 if name in values:
                     values[name][i] = getattr(resp.frf, name)
                     errors[name][i] = getattr(resp.stderr, name)
-        cells = (rec.meta["nx"], rec.meta["ny"])
+        cells, grids = rec.meta["cells"], rec.meta["grids"]
         records.append({"dof": case.dof, "K": case.fundamental, "Ks": list(ks), "steps": rec.steps,
                         "wall_s": rec.wall_s, "resumed_from_step": rec.resumed_from_step,
                         "periods": responses[0].periods, "t": rec.t, "lift": rec.lift, "moment": rec.moment,
@@ -144,7 +146,7 @@ def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
     table.name = f"cfd ({section.name}, {quality}, Re {q.reynolds:g})"
     model = table if static is None else WithLateral(table, static.quasi_steady())
     data = AeroResult(section.describe(), quality, q.reynolds, cells, Ks, frf, stderr, model, tuple(records),
-                      warning, static, tuple(static_records))
+                      warning, static, tuple(static_records), aopts.grid, grids)
     return StageOutput(summary=_summary(data), write_h5=lambda g: _write_h5(g, data), report=_report(data),
                        figures=_figures(data), data=data)
 
@@ -183,7 +185,7 @@ def _static_runs(poly, section, aopts: AeroOptions, q, runs, options: RunOptions
 
 def _summary(d: AeroResult) -> dict[str, Any]:
     s: dict[str, Any] = {"aero.section": d.section, "aero.quality": d.quality, "aero.reynolds": d.reynolds,
-                         "aero.cases": len(d.records), "aero.grid_cells": d.cells[0] * d.cells[1],
+                         "aero.cases": len(d.records), "aero.grid_cells": d.cells, "aero.grid": d.grid,
                          "aero.reduced_velocity_min": float(d.reduced_velocity.min()),
                          "aero.reduced_velocity_max": float(d.reduced_velocity.max()),
                          "aero.cfd_wall_s": float(sum(r["wall_s"] for r in d.records + d.static_records))}
@@ -203,6 +205,7 @@ def _write_h5(group: Any, d: AeroResult) -> None:
     n = d.reduced_frequency.size
     group.attrs["section"] = d.section
     group.attrs["quality"] = d.quality
+    group.attrs["grid"] = d.grid
     group.attrs["reynolds"] = d.reynolds
     write_dataset(group, "reduced_frequency", d.reduced_frequency, "1", f"({n},) K = Omega = w B / V of the runs")
     write_dataset(group, "reduced_velocity", d.reduced_velocity, "1", f"({n},) U / (f B) = 2 pi / K")
@@ -256,7 +259,7 @@ def _report(d: AeroResult) -> str:
     theo = derivatives_from_frf(d.reduced_frequency, Theodorsen().frf(d.reduced_frequency, 1.0))
     der = d.derivatives
     lines = ["## Aerodynamics of the deck section from forced-motion CFD (thesis 5.2-5.3)", "",
-             f"{d.section}; preset {d.quality!r}: {d.cells[0]} x {d.cells[1]} cells, laminar at Re = {d.reynolds:g} "
+             f"{d.section}; preset {d.quality!r}, {d.grid} grid ({d.grids}), laminar at Re = {d.reynolds:g} "
              "(the deck's Re of about 1e8 needs the turbulence model of a later stage: these are low-Reynolds "
              "numbers).  Heave and pitch with the thesis's velocity amplitudes, transient periods dropped, a "
              "least-squares harmonic fit over the whole periods left (docs/aero.md).", ""]
