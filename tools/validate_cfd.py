@@ -173,11 +173,12 @@ def dfg_cells_across(ppd):
     return int(round(DFG_H / (DFG_D / ppd)))
 
 
-def dfg(ppd, t_end, threads, scheme, ib_order=1, ny_shift=0, overset=None):
+def dfg(ppd, t_end, threads, scheme, ib_order=1, ny_shift=0, overset=None, body_shift=0.0):
     """DFG 2D-1 on a uniform grid h = D/ppd; ``ny_shift`` adds cells across the channel (dy =
     0.41/(ny + ny_shift), nearly the same resolution, the cylinder cut differently by the grid).
     ``overset`` = background cells per diameter: the cylinder in a body grid of h = D/ppd spanning
-    +-1 D around it (``bridge.cfd.OversetPair``) over a uniform background of h = D/overset."""
+    +-1 D around it (``bridge.cfd.OversetPair``) over a uniform background of h = D/overset, the body
+    grid shifted by ``body_shift`` of its cells in x and y (the cylinder cut differently)."""
     d, h_ch, length, nu, umax = DFG_D, DFG_H, 2.2, 1e-3, 0.3
 
     def profile(y, t):
@@ -203,7 +204,8 @@ def dfg(ppd, t_end, threads, scheme, ib_order=1, ny_shift=0, overset=None):
         f = f[:, 0, :]
         probe, centre, cells, steps = sim, (0.2, 0.2), nx * ny, sim.n_steps
     else:
-        body_grid = CartesianGrid.uniform(2 * ppd, 2 * ppd, (-d, d), (-d, d))
+        sh = body_shift * d / ppd
+        body_grid = CartesianGrid.uniform(2 * ppd, 2 * ppd, (-d + sh, d + sh), (-d + sh, d + sh))
         pair = OversetPair(grid, body_grid, cfg, Stationary(0.2, 0.2), polygon=circle(d))
         pair.background.set_state(u=u0)
         pair.set_initial_state()
@@ -227,7 +229,8 @@ def dfg(ppd, t_end, threads, scheme, ib_order=1, ny_shift=0, overset=None):
 
     dp, dp_linear = (_line_pressure(probe, centre[0] - d / 2, -1, centre[1], phi, n)
                      - _line_pressure(probe, centre[0] + d / 2, +1, centre[1], phi, n) for n in (3, 2))
-    return {"case": "DFG 2D-1", "ppd": ppd, "overset_background_ppd": overset, "cells": cells, "nx": nx, "ny": ny,
+    return {"case": "DFG 2D-1", "ppd": ppd, "overset_background_ppd": overset, "body_shift": body_shift,
+            "cells": cells, "nx": nx, "ny": ny,
             "t_end": float(t[-1]), "steps": steps, "wall_s": wall, "blockage": d / h_ch, "advection": scheme,
             "ib_order": ib_order, "ny_shift": ny_shift, "c_D": float(scale * f[-1, 0]),
             "c_L": float(scale * f[-1, 1]), "dp": dp, "dp_linear": dp_linear,
@@ -284,6 +287,9 @@ def main(argv=None):
                          "differently): shows how much of c_L depends on where the grid cuts the body")
     ap.add_argument("--overset", type=int, default=None, metavar="BG_PPD",
                     help="dfg: the cylinder in a body grid of h = D/ppd over a background of h = D/BG_PPD")
+    ap.add_argument("--body-shift", type=float, nargs="+", default=[0.0],
+                    help="dfg --overset: shift of the body grid against the cylinder, in body-grid cells (the "
+                         "overset counterpart of --ny-shift)")
     ap.add_argument("--out", default="out/validation_cfd.jsonl")
     args = ap.parse_args(argv)
     wp.config.quiet = True
@@ -291,14 +297,17 @@ def main(argv=None):
     _check_args(ap, args)
     results = []
     for ppd in args.ppd:
-        for variant in (args.ny_shift if args.case == "dfg" else args.shape if args.case == "heave" else [0]):
+        variants = (args.body_shift if args.overset else args.ny_shift) if args.case == "dfg" \
+            else args.shape if args.case == "heave" else [0]
+        for variant in variants:
             if args.case == "heave":
                 r = heave(variant, ppd, args.re, args.t_end, args.window, args.threads, args.advection)
             elif args.case == "cylinder":
                 r = cylinder(args.re, ppd, args.t_end, args.window, args.threads, args.advection,
                              *args.domain, ib_order=args.ib_order)
             else:
-                r = dfg(ppd, args.t_end, args.threads, args.advection, args.ib_order, variant, args.overset)
+                r = dfg(ppd, args.t_end, args.threads, args.advection, args.ib_order,
+                        0 if args.overset else variant, args.overset, variant if args.overset else 0.0)
             r["command"] = command
             _emit(r, args.out)
             results.append(r)
