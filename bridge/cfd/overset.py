@@ -176,10 +176,13 @@ class _Fringe(StageHook):
         self.mask_u = (iu <= 0) | (iu >= nx) | (ju < 0) | (ju >= ny)
         jv, iv = np.meshgrid(np.arange(-g, ny + g + 1), np.arange(-g, nx + g), indexing="ij")
         self.mask_v = (iv < 0) | (iv >= nx) | (jv <= 0) | (jv >= ny)
-        self.normal_u = np.zeros_like(self.mask_u)
-        self.normal_u[g:g + ny, [g, g + nx]] = True
-        self.normal_v = np.zeros_like(self.mask_v)
-        self.normal_v[[g, g + ny], g:g + nx] = True
+        normal_u = np.zeros_like(self.mask_u)
+        normal_u[g:g + ny, [g, g + nx]] = True
+        normal_v = np.zeros_like(self.mask_v)
+        normal_v[[g, g + ny], g:g + nx] = True
+        # index arrays (faster than boolean masks over the whole grid, every stage)
+        self.mask_u, self.mask_v = np.nonzero(self.mask_u), np.nonzero(self.mask_v)
+        self.normal_u, self.normal_v = np.nonzero(normal_u), np.nonzero(normal_v)
         self._t = None
 
     def _faces(self, t_new):
@@ -214,18 +217,20 @@ class _Hole(StageHook):
     def __init__(self, pair: OversetPair):
         self.pair = pair
         self.n_forced = 0
+        self._hy_f = pair.background.grid.hy_faces()
+        self._t, self._targets = None, None
 
     def after_predict(self, sim, k, t_new, c):
-        targets = self.pair.hole_targets(t_new)
-        if targets is None:
+        if self._t != t_new:   # every stage of a step targets the same time
+            self._targets, self._t = self.pair.hole_targets(t_new), t_new
+        if self._targets is None:
             return
-        (ju, iu, tu), (jv, iv, tv) = targets
-        grid = sim.grid
+        (ju, iu, tu), (jv, iv, tv) = self._targets
         p = sim.p.numpy()
         us, vs = sim.u_star.numpy(), sim.v_star.numpy()
         # compensation: the projection that follows subtracts c grad phi, phi = p at a steady state
-        us[ju, iu] = tu + c * (p[ju, iu] - p[ju, iu - 1]) / grid.dx
-        vs[jv, iv] = tv + c * (p[jv, iv] - p[jv - 1, iv]) / grid.hy_faces()[jv]
+        us[ju, iu] = tu + c * (p[ju, iu] - p[ju, iu - 1]) / sim.grid.dx
+        vs[jv, iv] = tv + c * (p[jv, iv] - p[jv - 1, iv]) / self._hy_f[jv]
         self.n_forced = ju.size + jv.size
         self.pair.sync_device(sim, (sim.u_star, us), (sim.v_star, vs))
 
@@ -311,7 +316,7 @@ class OversetPair:
         self.body.u.assign((psi[1:, :] - psi[:-1, :]) / dy)
         self.body.v.assign(-(psi[:, 1:] - psi[:, :-1]) / gb.dx)
         self.body.t = self.t = t
-        self._fringe._t = None
+        self._fringe._t = self._hole._t = None
         self._psi_hist = [(self.t, stream_function(self.body))]
 
     # --- frames -------------------------------------------------------------------------------
@@ -435,4 +440,4 @@ class OversetPair:
         self.t, self.n_steps = float(t), int(n_steps)
         times = np.atleast_1d(arrays["psi_times"])
         self._psi_hist = [(float(tk), np.asarray(arrays[f"psi_{k}"])) for k, tk in enumerate(times)]
-        self._fringe._t = None
+        self._fringe._t = self._hole._t = None

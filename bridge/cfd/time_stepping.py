@@ -168,13 +168,21 @@ class Simulation:
         (vx - omega y, vy + omega x) in the grid's axes, which turn at ``omega``. The state is then the
         absolute velocity in the grid's axes (the predictor advects it with the velocity relative to
         the grid and adds the turning axes' source, kernels.cfd.predict_u). (0, 0, 0): a fixed grid."""
+        if (vx, vy, omega) == getattr(self, "_frame", None):
+            return
+        self._frame = (vx, vy, omega)
         g, gr = GHOST, self.grid
-        xc = gr.x_faces[0] + (np.arange(self.frame_y.shape[0]) - g + 0.5) * gr.dx
-        xu = gr.x_faces[0] + (np.arange(self.frame_yu.shape[0]) - g) * gr.dx
-        self.frame_x.assign(vx - omega * gr.storage_y_centres())
-        self.frame_xf.assign(vx - omega * gr.storage_y_faces())
-        self.frame_y.assign(vy + omega * xc)
-        self.frame_yu.assign(vy + omega * xu)
+        if not hasattr(self, "_frame_coords"):
+            self._frame_coords = (gr.storage_y_centres(), gr.storage_y_faces(),
+                                  gr.x_faces[0] + (np.arange(self.frame_y.shape[0]) - g + 0.5) * gr.dx,
+                                  gr.x_faces[0] + (np.arange(self.frame_yu.shape[0]) - g) * gr.dx)
+        yc, yf, xc, xu = self._frame_coords
+        for arr, values in ((self.frame_x, vx - omega * yc), (self.frame_xf, vx - omega * yf),
+                            (self.frame_y, vy + omega * xc), (self.frame_yu, vy + omega * xu)):
+            if self._host:
+                arr.numpy()[:] = values   # a view on the CPU: no copy
+            else:
+                arr.assign(values)
         self.frame_omega = float(omega)
 
     def set_viscosity(self, nu_eff) -> None:
