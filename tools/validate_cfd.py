@@ -11,6 +11,10 @@ D/H = 1/30 (``--domain UPSTREAM DOWNSTREAM HALF_HEIGHT`` changes the box).
 Reported: C_D = 2 F_x/(rho U^2 D) (mean over whole shedding periods when unsteady),
 recirculation length L_w/D (last zero of u on the wake centreline, from the rear of the cylinder),
 Strouhal number from the zero up-crossings of C_L over the last ``--window`` time units.
+DFG 2D-2 (``dfg2``): the same channel with U_max = 1.5 (Re 100, periodic shedding): c_D,max, c_L,max
+and St = f D / U_mean over the last ``--window`` (at most half the run), the force series written next
+to ``--out`` as dfg2_ppd<N>[_bg<M>].h5 and .png. ``--overset BG_PPD`` (dfg, dfg2): the cylinder in a
+body grid of h = D/ppd spanning +-1 D (``bridge.cfd.OversetPair``) over a background of h = D/BG_PPD.
 DFG 2D-1 (Schaefer and Turek 1996): channel 2.2 x 0.41, D = 0.1 at (0.2, 0.2), nu = 1e-3, parabolic
 inflow U_max = 0.3, no-slip walls; c_D, c_L on U_mean = 0.2; pressure difference between the front
 and rear points of the cylinder, each extrapolated along the line y = 0.2 from the nearest cells
@@ -61,6 +65,7 @@ BANDS = {  # docs/reference_cases.md
     40: {"C_D": (1.50, 1.58), "L_w/D": (2.13, 2.35)},
     100: {"St": (0.160, 0.168), "C_D": (1.33, 1.40)},
     "dfg": {"c_D": (5.57, 5.59), "c_L": (0.0104, 0.0110), "dp": (0.1172, 0.1176)},
+    "dfg2": {"c_D_max": (3.22, 3.24), "c_L_max": (0.99, 1.01), "St": (0.295, 0.305)},
 }
 
 
@@ -173,13 +178,16 @@ def dfg_cells_across(ppd):
     return int(round(DFG_H / (DFG_D / ppd)))
 
 
-def dfg(ppd, t_end, threads, scheme, ib_order=1, ny_shift=0, overset=None, body_shift=0.0):
+def dfg(ppd, t_end, threads, scheme, ib_order=1, ny_shift=0, overset=None, body_shift=0.0, unsteady=False,
+        window=3.0, series_out=None):
     """DFG 2D-1 on a uniform grid h = D/ppd; ``ny_shift`` adds cells across the channel (dy =
     0.41/(ny + ny_shift), nearly the same resolution, the cylinder cut differently by the grid).
     ``overset`` = background cells per diameter: the cylinder in a body grid of h = D/ppd spanning
     +-1 D around it (``bridge.cfd.OversetPair``) over a uniform background of h = D/overset, the body
-    grid shifted by ``body_shift`` of its cells in x and y (the cylinder cut differently)."""
-    d, h_ch, length, nu, umax = DFG_D, DFG_H, 2.2, 1e-3, 0.3
+    grid shifted by ``body_shift`` of its cells in x and y (the cylinder cut differently).
+    ``unsteady``: DFG 2D-2 (U_max = 1.5, Re 100, periodic shedding): c_D,max, c_L,max and St over the
+    last ``window``, the force series written to ``series_out`` (.h5 and .png)."""
+    d, h_ch, length, nu, umax = DFG_D, DFG_H, 2.2, 1e-3, (1.5 if unsteady else 0.3)
 
     def profile(y, t):
         return 4 * umax * y * (h_ch - y) / h_ch ** 2
@@ -229,6 +237,17 @@ def dfg(ppd, t_end, threads, scheme, ib_order=1, ny_shift=0, overset=None, body_
 
     dp, dp_linear = (_line_pressure(probe, centre[0] - d / 2, -1, centre[1], phi, n)
                      - _line_pressure(probe, centre[0] + d / 2, +1, centre[1], phi, n) for n in (3, 2))
+    if unsteady:
+        cd, cl = scale * f[:, 0], scale * f[:, 1]
+        sel = t > t[-1] - window
+        st, _ = _strouhal(t, cl, window)
+        row = {"case": "DFG 2D-2", "ppd": ppd, "overset_background_ppd": overset, "body_shift": body_shift,
+               "cells": cells, "t_end": float(t[-1]), "steps": steps, "wall_s": wall, "window": window,
+               "c_D_max": float(cd[sel].max()), "c_L_max": float(cl[sel].max()), "c_L_min": float(cl[sel].min()),
+               "St": st * d / um, "band": BANDS["dfg2"]}
+        if series_out is not None:
+            _write_series(series_out, t, cd, cl, row)
+        return row
     return {"case": "DFG 2D-1", "ppd": ppd, "overset_background_ppd": overset, "body_shift": body_shift,
             "cells": cells, "nx": nx, "ny": ny,
             "t_end": float(t[-1]), "steps": steps, "wall_s": wall, "blockage": d / h_ch, "advection": scheme,
@@ -237,6 +256,36 @@ def dfg(ppd, t_end, threads, scheme, ib_order=1, ny_shift=0, overset=None, body_
             "c_D_drift_per_time": float(np.polyfit(t[last] - t[-1], scale * f[last, 0], 1)[0])
             if last.sum() > 2 else np.nan,
             "band": BANDS["dfg"]}
+
+
+def _write_series(stem: Path, t, cd, cl, row) -> None:
+    """Force series as HDF5 (t, c_D, c_L; the row's numbers as attributes) and a PNG plot."""
+    import h5py
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    stem.parent.mkdir(parents=True, exist_ok=True)
+    with h5py.File(stem.with_suffix(".h5"), "w") as h5:
+        for name, values in (("t", t), ("c_D", cd), ("c_L", cl)):
+            h5.create_dataset(name, data=values)
+        for k, v in row.items():
+            if isinstance(v, (int, float, str)) and v is not None:
+                h5.attrs[k] = v
+    fig, ax = plt.subplots(2, 1, sharex=True, figsize=(8, 5), layout="constrained")
+    ax[0].plot(t, cd)
+    ax[0].set_ylabel("c_D")
+    ax[1].plot(t, cl)
+    ax[1].set_ylabel("c_L")
+    ax[1].set_xlabel("t")
+    lo, hi = row["band"]["c_L_max"]
+    ax[1].axhspan(lo, hi, color="0.85", label="DFG 2D-2 band of c_L,max")
+    ax[1].legend(loc="lower left")
+    ax[0].set_title(f"DFG 2D-2, body grid D/{row['ppd']}" + (f" over D/{row['overset_background_ppd']}"
+                                                            if row["overset_background_ppd"] else " (single grid)"))
+    fig.savefig(stem.with_suffix(".png"), dpi=110)
+    plt.close(fig)
 
 
 def heave(shape, ppd, re, t_end, window, threads, scheme):
@@ -270,7 +319,7 @@ def heave(shape, ppd, re, t_end, window, threads, scheme):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("case", choices=["cylinder", "dfg", "heave"])
+    ap.add_argument("case", choices=["cylinder", "dfg", "dfg2", "heave"])
     ap.add_argument("--shape", nargs="+", choices=["circle", "deck"], default=["circle"], help="heave: body")
     ap.add_argument("--re", type=float, default=20)
     ap.add_argument("--ppd", type=int, nargs="+", default=[20])
@@ -297,7 +346,7 @@ def main(argv=None):
     _check_args(ap, args)
     results = []
     for ppd in args.ppd:
-        variants = (args.body_shift if args.overset else args.ny_shift) if args.case == "dfg" \
+        variants = (args.body_shift if args.overset else args.ny_shift) if args.case in ("dfg", "dfg2") \
             else args.shape if args.case == "heave" else [0]
         for variant in variants:
             if args.case == "heave":
@@ -306,8 +355,11 @@ def main(argv=None):
                 r = cylinder(args.re, ppd, args.t_end, args.window, args.threads, args.advection,
                              *args.domain, ib_order=args.ib_order)
             else:
+                stem = Path(args.out).with_name(f"{args.case}_ppd{ppd}" + (f"_bg{args.overset}" if args.overset else "")
+                                                + (f"_shift{variant:g}" if variant else ""))
                 r = dfg(ppd, args.t_end, args.threads, args.advection, args.ib_order,
-                        0 if args.overset else variant, args.overset, variant if args.overset else 0.0)
+                        0 if args.overset else variant, args.overset, variant if args.overset else 0.0,
+                        unsteady=args.case == "dfg2", window=min(args.window, args.t_end / 2), series_out=stem)
             r["command"] = command
             _emit(r, args.out)
             results.append(r)
@@ -324,12 +376,12 @@ def _check_args(ap, args):
               ("--domain", args.domain, min(args.domain[:2]) >= 1 and args.domain[2] > 1.5,
                "UPSTREAM, DOWNSTREAM >= 1 D and HALF_HEIGHT > 1.5 D (the refined band is +-1.5 D)")]
     if args.overset is not None:
-        checks.append(("--overset", args.overset, args.overset >= 4 and args.case == "dfg",
-                       ">= 4 background cells per diameter, with the dfg case"))
+        checks.append(("--overset", args.overset, args.overset >= 4 and args.case in ("dfg", "dfg2"),
+                       ">= 4 background cells per diameter, with the dfg or dfg2 case"))
     for name, value, ok, allowed in checks:
         if not ok:
             ap.error(f"{name}: {value} not allowed; allowed: {allowed}")
-    if args.case == "dfg" and any(dfg_cells_across(ppd) + k < 1 for ppd in args.ppd for k in args.ny_shift):
+    if args.case in ("dfg", "dfg2") and any(dfg_cells_across(ppd) + k < 1 for ppd in args.ppd for k in args.ny_shift):
         ap.error(f"--ny-shift: {args.ny_shift} leaves no cells across the channel")
 
 
