@@ -111,3 +111,14 @@ def test_a_checkpoint_of_other_solver_code_is_not_resumed(monkeypatch):
     monkeypatch.setattr(cache, "_code_digest", lambda modules: "edited")
     assert case_key(poly, case, QUALITY["tiny"]) != before
 
+
+
+def test_the_grid_option_is_checked_and_picks_the_overset_pair():
+    from bridge.aero.options import AeroOptions
+    from bridge.errors import InputError
+
+    with pytest.raises(InputError, match="aero.grid.*single, overset"):
+        AeroOptions(grid="chimera")
+    assert preset("quick", "overset").overset and not preset("quick").overset
+    with pytest.raises(InputError, match="aero.grid"):
+        preset("quick", "chimera")
