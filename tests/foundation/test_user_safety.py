@@ -75,6 +75,7 @@ def test_rerun_into_a_result_folder_is_refused_and_overwrite_keeps_the_users_fil
     assert not list((tmp_path / "great_belt").glob("fem_*.png"))
 
 
+@pytest.mark.slow  # ~9 s of full pipeline runs: runs in CI with -m slow (default run under 2 min)
 def test_a_users_file_named_like_an_output_is_never_overwritten(tmp_path):
     out = str(tmp_path)
     assert cli("great_belt", "--stages", "cable", "--quick", "--quiet", "--out", out).returncode == 0
@@ -253,6 +254,7 @@ def test_summary_json_is_strict_json(tmp_path):
 
 
 # ------------------------------------------------------------------------------ sweeps
+@pytest.mark.slow  # ~11 s of full pipeline runs: runs in CI with -m slow (default run under 2 min)
 def test_sweep_resumes_only_cases_run_with_the_same_stages(tmp_path):
     base = ["great_belt", "--main-span", "1624", "--quick", "--workers", "1", "--out", str(tmp_path)]
     assert cli(*base, "--stages", "cable", module="bridge.sweep").returncode == 0
@@ -436,6 +438,7 @@ def test_a_shared_stage_is_one_result_for_scenarios_of_other_names(monkeypatch):
 
 
 # ------------------------------------------------------------------------------ what a user reads
+@pytest.mark.slow  # ~15 s of full pipeline runs: runs in CI with -m slow (default run under 2 min)
 def test_headline_on_the_terminal_and_atop_the_report(tmp_path):
     proc = cli("great_belt", "thin_plate_section", "--quick", "--out", str(tmp_path))
     assert proc.returncode == 0, proc.stderr
@@ -452,6 +455,7 @@ def test_headline_on_the_terminal_and_atop_the_report(tmp_path):
         assert row in table
 
 
+@pytest.mark.slow  # ~6 s of full pipeline runs: runs in CI with -m slow (default run under 2 min)
 def test_no_cuda_warning_on_a_cpu_run(tmp_path):
     proc = cli("great_belt", "--stages", "fem", "--quick", "--out", str(tmp_path))
     assert proc.returncode == 0, proc.stderr
