@@ -264,7 +264,6 @@ class OversetPair:
             self.body.bodies.append(_FrameBody(poly, motion, body_grid, self.body.L, stages=len(self.body.stages)))
             self.body.last_force.append(np.zeros(3))
         gbg, gb = background_grid, body_grid
-        self._bg_interp_x = gbg.x_faces
         self._body_interp = CornerInterpolator(gb.x_faces, gb.y_faces)
         # the background's largest spacing where the body grid is (its initial place, any rotation: within
         # its half-diagonal of its centre): the hole starts ``overlap`` such cells inside the body grid
@@ -291,7 +290,6 @@ class OversetPair:
         self.body.hooks.append(self._fringe)
         self.background.hooks.append(self._hole)
         self._psi_hist: list[tuple[float, np.ndarray]] = []   # (t, body psi) of the last two steps
-        self._bg_psi = None
         self.t = 0.0
         self.n_steps = 0
 
