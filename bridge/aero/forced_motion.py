@@ -65,8 +65,8 @@ class Quality:
     settle_time: float = 16.0       # forced motion: at least this many B / V dropped before the fit
     # overset grids (bridge.cfd.overset): the section in a body grid of this preset's spacing (dx, and
     # dy = dy_over_dx dx) reaching ``body_margin`` chords (at least 6 background cells) beyond it, over a
-    # background whose cells are
-    # ``background_coarsening`` times larger; False: one grid, the section an immersed body moving on it
+    # background whose cells are ``background_coarsening`` times larger; False: one grid, the section an
+    # immersed body moving on it
     overset: bool = False
     background_coarsening: int = 2
     body_margin: float = 0.35
@@ -261,16 +261,22 @@ class ForceRecord:
     snapshot: dict | None = None    # the flow at the end of the run (bridge.aero.snapshots.flow_snapshot)
 
 
-def _grid(q: Quality, reach: float):
+def _grid(q: Quality, reach: float, h: float | None = None, upstream: float | None = None,
+          downstream: float | None = None, side_cells: int = 0):
     """The preset's grid; the uniform core band holds the body wherever the motion takes it (``reach``:
-    largest |y| of the body over the motion) with 4 cells to spare."""
+    largest |y| of the body over the motion) with 4 cells to spare.  ``h`` (default the preset's dx),
+    ``upstream``, ``downstream`` override the preset's; ``side_cells``: cells kept between the core and
+    the sides at least (the sides move out if needed)."""
     from bridge.cfd import CartesianGrid, stretched_faces
 
-    h = 1.0 / q.cells_per_chord
-    nx = int(round((q.upstream + q.downstream) / h))
-    x = np.linspace(-q.upstream, q.downstream, nx + 1)
+    h = 1.0 / q.cells_per_chord if h is None else h
+    up = q.upstream if upstream is None else upstream
+    down = q.downstream if downstream is None else downstream
+    nx = int(round((up + down) / h))
+    x = np.linspace(-up, down, nx + 1)
     core = max(q.core_half_height, reach + 4 * h)
-    y = stretched_faces(-q.half_height, q.half_height, (-core, core), q.dy_over_dx * h, q.stretch)
+    half = max(q.half_height, core + side_cells * h)
+    y = stretched_faces(-half, half, (-core, core), q.dy_over_dx * h, q.stretch)
     return CartesianGrid(x, y)
 
 
@@ -349,7 +355,7 @@ def run_case(shape, case: ForcedCase | StaticCase, quality: Quality, checkpoint:
     q = quality
     polys = _polygons(shape)
     try:
-        flow = _OversetFlow(q, polys, case, threads) if q.overset else _SingleGridFlow(q, polys, case, threads)
+        flow = _overset_flow(q, polys, case, threads) if q.overset else _SingleGridFlow(q, polys, case, threads)
     except ValueError as err:   # the section and the preset's grid do not fit together
         raise InputError("aero.quality", q.name, f"its {'overset' if q.overset else 'single'} grid cannot hold "
                          f"this section and motion ({err})") from None
@@ -412,7 +418,9 @@ def _march(flow, polys, case, q, checkpoint, checkpoint_every, progress, label) 
 
 
 class _SingleGridFlow:
-    """One grid, the section an immersed body moving on it."""
+    """One grid, the section an immersed body moving on it.  A flow for :func:`_march`: ``t``,
+    ``n_steps``, ``last_force`` (summed over the parts), ``step``, ``stable_dt``, ``simulations``,
+    ``n_cells``, ``describe``, ``checkpoint_arrays`` / ``restore_arrays``."""
 
     def __init__(self, q: Quality, polys, case, threads):
         from bridge.cfd import BoundaryConditions, FlowConfig, Simulation
@@ -452,65 +460,35 @@ class _SingleGridFlow:
         self.sim.t, self.sim.n_steps = t, n_steps
 
 
-class _OversetFlow(_SingleGridFlow):
+def _overset_flow(q: Quality, polys, case, threads):
     """The section in a body grid that moves with it over a coarser fixed background
-    (``bridge.cfd.OversetPair``; ``Quality.overset``)."""
+    (``bridge.cfd.OversetPair``, which has the flow interface of :class:`_SingleGridFlow`)."""
+    from bridge.cfd import BoundaryConditions, CartesianGrid, FlowConfig, OversetPair
 
-    def __init__(self, q: Quality, polys, case, threads):
-        from bridge.cfd import BoundaryConditions, CartesianGrid, FlowConfig, OversetPair, stretched_faces
-
-        h = 1.0 / q.cells_per_chord
-        dy = q.dy_over_dx * h
-        xs = np.concatenate([p.vertices[:, 0] for p in polys])
-        ys = np.concatenate([p.vertices[:, 1] for p in polys])
-        H = q.background_coarsening * h
-        m = max(q.body_margin, 6 * H)   # the hole (4 background cells inside the body grid) covers the body
-        nbx = int(np.ceil((xs.max() - xs.min() + 2 * m) / h))
-        nby = int(np.ceil((ys.max() - ys.min() + 2 * m) / dy))
-        cx, cy = 0.5 * (xs.max() + xs.min()), 0.5 * (ys.max() + ys.min())
-        body = CartesianGrid.uniform(nbx, nby, (cx - 0.5 * nbx * h, cx + 0.5 * nbx * h),
-                                     (cy - 0.5 * nby * dy, cy + 0.5 * nby * dy))
-        # background: the preset's grid with cells background_coarsening times larger, its uniform core
-        # holding the body grid wherever the motion takes it
-        up = max(q.upstream, -body.x_faces[0] + 8 * H)   # the fringe stays clear of the in- and outflow
-        down = max(q.downstream, body.x_faces[-1] + 8 * H)
-        nx = int(round((up + down) / H))
-        x = np.linspace(-up, down, nx + 1)
-        corners = np.array([[body.x_faces[i], body.y_faces[j]] for i in (0, -1) for j in (0, -1)])
-        reach = float(np.abs(corners[:, 1]).max()) + case.excursion(float(np.hypot(*corners.T).max()))
-        core = max(q.core_half_height, reach + 4 * H)
-        half = max(q.half_height, core + 8 * H)   # the body grid's fringe stays clear of the sides
-        y = stretched_faces(-half, half, (-core, core), q.dy_over_dx * H, q.stretch)
-        background = CartesianGrid(x, y)
-        if threads is None:
-            threads = 1 if background.nx * background.ny < 20_000 else 2
-        bc = BoundaryConditions(left="inflow", right="outflow", bottom="slip", top="slip")
-        config = FlowConfig(nu=1.0 / q.reynolds, advection="vanleer", cfl=q.cfl, threads=threads, bc=bc)
-        self.pair = OversetPair(background, body, config, case.motion(), polygon=polys)
-        self.pair.set_uniform_flow(1.0)
-        self.simulations = [self.pair.background, self.pair.body]
-        self.n_cells = self.pair.n_cells
-        self.sim = self.pair.background
-
-    t = property(lambda self: self.pair.t)
-    n_steps = property(lambda self: self.pair.n_steps)
-    last_force = property(lambda self: self.pair.last_force)
-
-    def step(self, dt):
-        return self.pair.step(dt)
-
-    def stable_dt(self):
-        return self.pair.stable_dt()
-
-    def describe(self) -> str:
-        b, g = self.pair.background.grid, self.pair.body.grid
-        return f"{b.nx} x {b.ny} + body {g.nx} x {g.ny} cells"
-
-    def checkpoint_arrays(self) -> dict:
-        return self.pair.checkpoint_arrays()
-
-    def restore_arrays(self, arrays: dict, t: float, n_steps: int) -> None:
-        self.pair.restore_arrays(arrays, t, n_steps)
+    h = 1.0 / q.cells_per_chord
+    dy = q.dy_over_dx * h
+    xs = np.concatenate([p.vertices[:, 0] for p in polys])
+    ys = np.concatenate([p.vertices[:, 1] for p in polys])
+    H = q.background_coarsening * h
+    m = max(q.body_margin, 6 * H)   # the hole (4 background cells inside the body grid) covers the body
+    nbx = int(np.ceil((xs.max() - xs.min() + 2 * m) / h))
+    nby = int(np.ceil((ys.max() - ys.min() + 2 * m) / dy))
+    cx, cy = 0.5 * (xs.max() + xs.min()), 0.5 * (ys.max() + ys.min())
+    body = CartesianGrid.uniform(nbx, nby, (cx - 0.5 * nbx * h, cx + 0.5 * nbx * h),
+                                 (cy - 0.5 * nby * dy, cy + 0.5 * nby * dy))
+    # background: the preset's grid with cells background_coarsening times larger, its uniform core holding
+    # the body grid wherever the motion takes it, and the fringe kept 8 cells clear of in-, outflow and sides
+    corners = np.array([[body.x_faces[i], body.y_faces[j]] for i in (0, -1) for j in (0, -1)])
+    reach = float(np.abs(corners[:, 1]).max()) + case.excursion(float(np.hypot(*corners.T).max()))
+    background = _grid(q, reach, h=H, upstream=max(q.upstream, -body.x_faces[0] + 8 * H),
+                       downstream=max(q.downstream, body.x_faces[-1] + 8 * H), side_cells=8)
+    if threads is None:
+        threads = 1 if background.nx * background.ny < 20_000 else 2
+    bc = BoundaryConditions(left="inflow", right="outflow", bottom="slip", top="slip")
+    config = FlowConfig(nu=1.0 / q.reynolds, advection="vanleer", cfl=q.cfl, threads=threads, bc=bc)
+    pair = OversetPair(background, body, config, case.motion(), polygon=polys)
+    pair.set_uniform_flow(1.0)
+    return pair
 
 
 def whole_periods(record: ForceRecord, case: ForcedCase, q: Quality) -> np.ndarray:

@@ -41,10 +41,12 @@ the centroid), and F = R (-rho M / dt + rho A R^T a_c), M_z as in ``immersed.py`
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 
 from .bodies import Polygon
+from .boundaries import BoundaryConditions
 from .grids import GHOST, CartesianGrid
 from .immersed import ImmersedBody
 from .time_stepping import FlowConfig, Simulation, StageHook
@@ -254,11 +256,9 @@ class OversetPair:
             raise ValueError(f"overlap: must be >= 3 background cells, got {overlap}")
         self.motion, self.config, self.overlap = motion, config, float(overlap)
         self.background = Simulation(background_grid, config, device=device)
-        from .boundaries import BoundaryConditions
-
-        body_config = FlowConfig(**{**{f: getattr(config, f) for f in config.__dataclass_fields__},
-                                    "bc": BoundaryConditions(left="slip", right="slip")})
-        self.body = Simulation(body_grid, body_config, device=device)
+        # the body grid's sides are all set by the fringe; "slip" only keeps its own boundary code idle
+        self.body = Simulation(body_grid, replace(config, bc=BoundaryConditions(left="slip", right="slip")),
+                               device=device)
         polygons = [] if polygon is None else list(polygon) if isinstance(polygon, (list, tuple)) else [polygon]
         for poly in polygons:
             self.body.bodies.append(_FrameBody(poly, motion, body_grid, self.body.L, stages=len(self.body.stages)))
@@ -284,7 +284,6 @@ class OversetPair:
                 hole = tuple(round(float(h), 4) for h in self.hole)
                 raise ValueError(f"body_grid: the hole {hole} (the body grid less {overlap} background cells) must "
                                  "cover the body; enlarge the body grid")
-        self.h_background = h_max
         self._fringe = _Fringe(self)
         self._hole = _Hole(self)
         self.body.hooks.append(self._fringe)
@@ -418,6 +417,15 @@ class OversetPair:
     @property
     def n_cells(self) -> int:
         return self.background.grid.nx * self.background.grid.ny + self.body.grid.nx * self.body.grid.ny
+
+    @property
+    def simulations(self) -> list[Simulation]:
+        """The two grids' solvers: the background first."""
+        return [self.background, self.body]
+
+    def describe(self) -> str:
+        b, g = self.background.grid, self.body.grid
+        return f"{b.nx} x {b.ny} + body {g.nx} x {g.ny} cells"
 
     # --- checkpoint ---------------------------------------------------------------------------
     def checkpoint_arrays(self) -> dict[str, np.ndarray]:

@@ -147,6 +147,10 @@ class Simulation:
         self.frame_y = z(pshape[1])    # y-velocity at the x of storage columns: cell centres
         self.frame_yu = z(ushape[1])   # ... and u-faces
         self.frame_omega = 0.0
+        self._frame = (0.0, 0.0, 0.0)
+        self._frame_coords = (grid.storage_y_centres(), grid.storage_y_faces(),
+                              grid.x_faces[0] + (np.arange(pshape[1]) - g + 0.5) * grid.dx,
+                              grid.x_faces[0] + (np.arange(ushape[1]) - g) * grid.dx)
         self.hooks: list[StageHook] = []   # the overset coupling's frame and fringe (bridge.cfd.overset)
         self.t = 0.0
         self.n_steps = 0
@@ -168,14 +172,9 @@ class Simulation:
         (vx - omega y, vy + omega x) in the grid's axes, which turn at ``omega``. The state is then the
         absolute velocity in the grid's axes (the predictor advects it with the velocity relative to
         the grid and adds the turning axes' source, kernels.cfd.predict_u). (0, 0, 0): a fixed grid."""
-        if (vx, vy, omega) == getattr(self, "_frame", None):
+        if (vx, vy, omega) == self._frame:
             return
         self._frame = (vx, vy, omega)
-        g, gr = GHOST, self.grid
-        if not hasattr(self, "_frame_coords"):
-            self._frame_coords = (gr.storage_y_centres(), gr.storage_y_faces(),
-                                  gr.x_faces[0] + (np.arange(self.frame_y.shape[0]) - g + 0.5) * gr.dx,
-                                  gr.x_faces[0] + (np.arange(self.frame_yu.shape[0]) - g) * gr.dx)
         yc, yf, xc, xu = self._frame_coords
         for arr, values in ((self.frame_x, vx - omega * yc), (self.frame_xf, vx - omega * yf),
                             (self.frame_y, vy + omega * xc), (self.frame_yu, vy + omega * xu)):
