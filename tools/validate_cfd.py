@@ -13,7 +13,7 @@ recirculation length L_w/D (last zero of u on the wake centreline, from the rear
 Strouhal number from the zero up-crossings of C_L over the last ``--window`` time units.
 DFG 2D-2 (``dfg2``): the same channel with U_max = 1.5 (Re 100, periodic shedding): c_D,max, c_L,max
 and St = f D / U_mean over the last ``--window`` (at most half the run), the force series written next
-to ``--out`` as dfg2_ppd<N>[_bg<M>].h5 and .png. ``--overset BG_PPD`` (dfg, dfg2): the cylinder in a
+to ``--out`` as dfg2_ppd<N>[_bg<M>].h5 and .png. ``--overset BG_PPD`` (dfg, dfg2, heave): the body in a
 body grid of h = D/ppd spanning +-1 D (``bridge.cfd.OversetPair``) over a background of h = D/BG_PPD.
 DFG 2D-1 (Schaefer and Turek 1996): channel 2.2 x 0.41, D = 0.1 at (0.2, 0.2), nu = 1e-3, parabolic
 inflow U_max = 0.3, no-slip walls; c_D, c_L on U_mean = 0.2; pressure difference between the front
@@ -170,6 +170,19 @@ def _line_pressure(sim, x_target, side, y_line, body_phi, points=3):
     return float(np.polyval(np.polyfit(xc[k] - x_target, line[k], points - 1), 0.0))
 
 
+def _march_pair(pair, t_end, label):
+    """Step an ``OversetPair`` to t_end like ``run()`` (no shortened last step: a step much shorter
+    than the one before spoils that step's forcing impulse, hence its force); (t, force) series."""
+    t, f = [], []
+    while pair.t < t_end - 1e-12:
+        pair.step()
+        t.append(pair.t)
+        f.append(pair.last_force)
+        if pair.n_steps % 200 == 0 and not np.isfinite(f[-1]).all():
+            raise FloatingPointError(f"{label} overset: non-finite force at t = {pair.t}")
+    return np.array(t), np.array(f)
+
+
 DFG_D, DFG_H = 0.1, 0.41  # cylinder diameter, channel height
 
 
@@ -217,14 +230,7 @@ def dfg(ppd, t_end, threads, scheme, ib_order=1, ny_shift=0, overset=None, body_
         pair = OversetPair(grid, body_grid, cfg, Stationary(0.2, 0.2), polygon=circle(d))
         pair.background.set_state(u=u0)
         pair.set_initial_state()
-        t, f = [], []
-        while pair.t < t_end - 1e-12:   # like run(): no shortened last step (a step much shorter than
-            pair.step()                 # the one before spoils that step's forcing impulse, hence its force)
-            t.append(pair.t)
-            f.append(pair.last_force)
-            if pair.n_steps % 200 == 0 and not np.isfinite(f[-1]).all():
-                raise FloatingPointError(f"DFG overset: non-finite force at t = {pair.t}")
-        t, f = np.array(t), np.array(f)
+        t, f = _march_pair(pair, t_end, "DFG")
         probe, centre = pair.body, (0.0, 0.0)
         cells, steps = nx * ny + body_grid.nx * body_grid.ny, pair.n_steps
     wall = time.perf_counter() - t0
@@ -288,33 +294,56 @@ def _write_series(stem: Path, t, cd, cl, row) -> None:
     plt.close(fig)
 
 
-def heave(shape, ppd, re, t_end, window, threads, scheme):
-    """Heaving (and, for the deck, pitching) body in a stream: force smoothness and first harmonic."""
-    grid = CartesianGrid.uniform(16 * ppd, 8 * ppd, (-4.0, 12.0), (-4.0, 4.0))
+def heave(shape, ppd, re, t_end, window, threads, scheme, overset=None):
+    """Heaving (and, for the deck, pitching) body in a stream: force smoothness and first harmonic.
+    ``overset`` = background cells per unit length: the body in a body grid of h = 1/ppd reaching
+    ``margin`` beyond it (0.5 or 6 background cells, whichever is more) over the same box at
+    h = 1/overset (``bridge.cfd.OversetPair``)."""
     bc = BoundaryConditions(left="inflow", right="outflow", bottom="slip", top="slip")
-    sim = Simulation(grid, FlowConfig(nu=1.0 / re, advection=scheme, cfl=0.5, threads=threads, bc=bc))
+    cfg = FlowConfig(nu=1.0 / re, advection=scheme, cfl=0.5, threads=threads, bc=bc)
     polygon, pitch = (circle(1.0), 0.0) if shape == "circle" else (box_deck(2.0, 0.2, 0.2), 0.05)
     omega = 2 * np.pi / 4.0
-    body = sim.add_body(polygon, HarmonicMotion(0.0, 0.0, (0.0, 0.1, pitch), omega))
-    sim.set_state(u=1.0)
-    hist, nan = ForceHistory(), NaNMonitor(every=200)
+    motion = HarmonicMotion(0.0, 0.0, (0.0, 0.1, pitch), omega)
+    bg_ppd = ppd if overset is None else overset
+    grid = CartesianGrid.uniform(16 * bg_ppd, 8 * bg_ppd, (-4.0, 12.0), (-4.0, 4.0))
     t0 = time.perf_counter()
-    run(sim, t_end, [hist, nan])
+    if overset is None:
+        sim = Simulation(grid, cfg)
+        body = sim.add_body(polygon, motion)
+        sim.set_state(u=1.0)
+        hist, nan = ForceHistory(), NaNMonitor(every=200)
+        run(sim, t_end, [hist, nan])
+        t, f = hist.array()
+        f = f[:, 0, :]
+        inside = body.solid_cells()
+        p = sim.interior()[2]
+        p_inside = float(p[inside].mean()) if inside.any() else None
+        cells, steps = grid.nx * grid.ny, sim.n_steps
+        t_last = sim.t
+    else:
+        v = polygon.vertices
+        m = max(0.5, 6.0 / overset)
+        nbx = int(np.ceil((np.ptp(v[:, 0]) + 2 * m) * ppd))
+        nby = int(np.ceil((np.ptp(v[:, 1]) + 2 * m) * ppd))
+        body_grid = CartesianGrid.uniform(nbx, nby, (-nbx / (2 * ppd), nbx / (2 * ppd)),
+                                          (-nby / (2 * ppd), nby / (2 * ppd)))
+        pair = OversetPair(grid, body_grid, cfg, motion, polygon=polygon)
+        pair.set_uniform_flow(1.0)
+        t, f = _march_pair(pair, t_end, "heave")
+        p_inside = None
+        cells, steps, t_last = pair.n_cells, pair.n_steps, pair.t
     wall = time.perf_counter() - t0
-    t, f = hist.array()
     sel = t > t[-1] - window
-    ts, fs = t[sel], f[sel, 0, :]
+    ts, fs = t[sel], f[sel]
     basis = np.column_stack([np.sin(omega * ts), np.cos(omega * ts), np.ones_like(ts)])
     coef = np.linalg.lstsq(basis, fs, rcond=None)[0]  # F ~ a sin + b cos + c
     d2_rms = np.sqrt(np.mean(np.diff(fs, 2, axis=0) ** 2, axis=0))
-    inside = body.solid_cells()
-    p = sim.interior()[2]
-    return {"case": "heave", "shape": shape, "ppd": ppd, "re": re, "cells": grid.nx * grid.ny,
-            "t_end": float(sim.t), "steps": sim.n_steps, "wall_s": wall,
+    return {"case": "heave", "shape": shape, "ppd": ppd, "overset_background_ppd": overset, "re": re,
+            "cells": cells, "t_end": float(t_last), "steps": steps, "cell_steps": cells * steps, "wall_s": wall,
             "first_harmonic_amplitude": np.hypot(coef[0], coef[1]).tolist(),
             "first_harmonic_phase_deg": np.degrees(np.arctan2(coef[1], coef[0])).tolist(),
             "noise_d2_rms": d2_rms.tolist(), "noise_d2_over_std": (d2_rms / fs.std(axis=0)).tolist(),
-            "p_inside_mean": float(p[inside].mean()) if inside.any() else None}
+            "p_inside_mean": p_inside}
 
 
 def main(argv=None):
@@ -335,7 +364,8 @@ def main(argv=None):
                     help="dfg: extra cells across the channel (same h within a few %%, the cylinder cut "
                          "differently): shows how much of c_L depends on where the grid cuts the body")
     ap.add_argument("--overset", type=int, default=None, metavar="BG_PPD",
-                    help="dfg: the cylinder in a body grid of h = D/ppd over a background of h = D/BG_PPD")
+                    help="dfg, dfg2, heave: the body in a body grid of h = 1/ppd over a background of h = 1/BG_PPD "
+                         "(lengths in D; heave: in units of the circle's D or half the deck's width)")
     ap.add_argument("--body-shift", type=float, nargs="+", default=[0.0],
                     help="dfg --overset: shift of the body grid against the cylinder, in body-grid cells (the "
                          "overset counterpart of --ny-shift)")
@@ -350,7 +380,8 @@ def main(argv=None):
             else args.shape if args.case == "heave" else [0]
         for variant in variants:
             if args.case == "heave":
-                r = heave(variant, ppd, args.re, args.t_end, args.window, args.threads, args.advection)
+                r = heave(variant, ppd, args.re, args.t_end, args.window, args.threads, args.advection,
+                          args.overset)
             elif args.case == "cylinder":
                 r = cylinder(args.re, ppd, args.t_end, args.window, args.threads, args.advection,
                              *args.domain, ib_order=args.ib_order)
@@ -376,8 +407,8 @@ def _check_args(ap, args):
               ("--domain", args.domain, min(args.domain[:2]) >= 1 and args.domain[2] > 1.5,
                "UPSTREAM, DOWNSTREAM >= 1 D and HALF_HEIGHT > 1.5 D (the refined band is +-1.5 D)")]
     if args.overset is not None:
-        checks.append(("--overset", args.overset, args.overset >= 4 and args.case in ("dfg", "dfg2"),
-                       ">= 4 background cells per diameter, with the dfg or dfg2 case"))
+        checks.append(("--overset", args.overset, args.overset >= 4 and args.case in ("dfg", "dfg2", "heave"),
+                       ">= 4 background cells per diameter, with the dfg, dfg2 or heave case"))
     for name, value, ok, allowed in checks:
         if not ok:
             ap.error(f"{name}: {value} not allowed; allowed: {allowed}")
