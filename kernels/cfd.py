@@ -598,3 +598,48 @@ def tridiag_columns(r: wp.array2d(dtype=wp.float64), scale: wp.array(dtype=wp.fl
         j = ny - 1 - jj
         for k in range(k0, k1):
             r[j, k] = r[j, k] - cprime[j, k] * r[j + 1, k]
+
+
+@wp.kernel
+def corner_interpolate(field: wp.array2d(dtype=wp.float64), x0: wp.float64, dx: wp.float64,
+                       y_nodes: wp.array(dtype=wp.float64), px: wp.array(dtype=wp.float64),
+                       py: wp.array(dtype=wp.float64), out: wp.array(dtype=wp.float64)):
+    """Cubic Lagrange interpolation (4 x 4 nodes) of ``field`` on the lattice x0 + i dx (uniform) by
+    ``y_nodes`` (any increasing spacing) at the points (px, py): the stencil nearest each point,
+    shifted inwards at the lattice's edges (the overset coupling, ``bridge.cfd.overset``)."""
+    k = wp.tid()
+    ny = field.shape[0]
+    nx = field.shape[1]
+    sx = (px[k] - x0) / dx
+    i = wp.clamp(int(wp.floor(sx)) - 1, 0, nx - 4)
+    s = sx - wp.float64(i)
+    one = wp.float64(1.0)
+    two = wp.float64(2.0)
+    three = wp.float64(3.0)
+    six = wp.float64(6.0)
+    wx = wp.vec4d(-(s - one) * (s - two) * (s - three) / six, s * (s - two) * (s - three) / two,
+                  -s * (s - one) * (s - three) / two, s * (s - one) * (s - two) / six)
+    y = py[k]
+    lo = int(0)  # noqa: UP018 (a Warp variable that the loop may reassign, not a constant)
+    hi = ny
+    while lo < hi:   # lo = the number of nodes <= y
+        mid = (lo + hi) // 2
+        if y_nodes[mid] <= y:
+            lo = mid + 1
+        else:
+            hi = mid
+    j = wp.clamp(lo - 2, 0, ny - 4)
+    y0 = y_nodes[j]
+    y1 = y_nodes[j + 1]
+    y2 = y_nodes[j + 2]
+    y3 = y_nodes[j + 3]
+    wy = wp.vec4d((y - y1) * (y - y2) * (y - y3) / ((y0 - y1) * (y0 - y2) * (y0 - y3)),
+                  (y - y0) * (y - y2) * (y - y3) / ((y1 - y0) * (y1 - y2) * (y1 - y3)),
+                  (y - y0) * (y - y1) * (y - y3) / ((y2 - y0) * (y2 - y1) * (y2 - y3)),
+                  (y - y0) * (y - y1) * (y - y2) / ((y3 - y0) * (y3 - y1) * (y3 - y2)))
+    acc = wp.float64(0.0)
+    for a in range(4):
+        row = wx[0] * field[j + a, i] + wx[1] * field[j + a, i + 1] + wx[2] * field[j + a, i + 2] \
+            + wx[3] * field[j + a, i + 3]
+        acc += wy[a] * row
+    out[k] = acc

@@ -52,6 +52,9 @@ import math
 from dataclasses import replace
 
 import numpy as np
+import warp as wp
+
+from kernels import cfd as _k
 
 from .bodies import Polygon
 from .boundaries import BoundaryConditions
@@ -67,39 +70,31 @@ def _rotation(theta: float) -> np.ndarray:
     return np.array([[c, -s], [s, c]])
 
 
-def _lagrange_weights(nodes: np.ndarray, points: np.ndarray) -> np.ndarray:
-    """Cubic Lagrange weights, (n, 4), of the four ``nodes`` (n, 4) at ``points`` (n,)."""
-    w = np.ones(nodes.shape)
-    for k in range(4):
-        for m in range(4):
-            if m != k:
-                w[:, k] *= (points - nodes[:, m]) / (nodes[:, k] - nodes[:, m])
-    return w
-
-
 class CornerInterpolator:
     """Cubic Lagrange interpolation (4 x 4 nodes; fourth order in the spacing) of a field on the
     corner lattice x_nodes x y_nodes (x uniform, y any increasing spacing), from the stencil nearest
-    each point, shifted inwards at the lattice's edges."""
+    each point, shifted inwards at the lattice's edges (``kernels.cfd.corner_interpolate``, on the
+    host: the coupling's fields are host arrays)."""
 
     def __init__(self, x_nodes: np.ndarray, y_nodes: np.ndarray):
         self.x0, self.dx, self.nx = float(x_nodes[0]), float(x_nodes[1] - x_nodes[0]), x_nodes.size
-        self.x_nodes, self.y_nodes = np.asarray(x_nodes, float), np.asarray(y_nodes, float)
+        self.y_nodes = np.ascontiguousarray(y_nodes, dtype=np.float64)
         if self.nx < 4 or self.y_nodes.size < 4:
             raise ValueError("CornerInterpolator: needs at least 4 x 4 nodes")
-
-    def stencil(self, px: np.ndarray, py: np.ndarray):
-        """(columns (n, 4), rows (n, 4), x weights (n, 4), y weights (n, 4)) of the points."""
-        i = np.clip(np.floor((px - self.x0) / self.dx).astype(int) - 1, 0, self.nx - 4)
-        j = np.clip(np.searchsorted(self.y_nodes, py, side="right") - 2, 0, self.y_nodes.size - 4)
-        cols = i[:, None] + np.arange(4)
-        rows = j[:, None] + np.arange(4)
-        return cols, rows, _lagrange_weights(self.x_nodes[cols], px), _lagrange_weights(self.y_nodes[rows], py)
+        self._y = wp.array(self.y_nodes, dtype=wp.float64, device="cpu", copy=False)
 
     def __call__(self, field: np.ndarray, px: np.ndarray, py: np.ndarray) -> np.ndarray:
-        cols, rows, wx, wy = self.stencil(px, py)
-        vals = field[rows[:, :, None], cols[:, None, :]]     # (n, 4 rows, 4 columns)
-        return np.einsum("nj,nji,ni->n", wy, vals, wx)
+        field = np.ascontiguousarray(field, dtype=np.float64)
+        if field.shape != (self.y_nodes.size, self.nx):
+            raise ValueError(f"CornerInterpolator: field {field.shape}, lattice {(self.y_nodes.size, self.nx)}")
+        px = np.ascontiguousarray(px, dtype=np.float64).reshape(-1)
+        py = np.ascontiguousarray(py, dtype=np.float64).reshape(-1)
+        out = np.empty(px.size)
+        if px.size:
+            host = lambda a: wp.array(a, dtype=wp.float64, device="cpu", copy=False)  # noqa: E731
+            wp.launch(_k.corner_interpolate, dim=px.size, device="cpu",
+                      inputs=[host(field), self.x0, self.dx, self._y, host(px), host(py)], outputs=[host(out)])
+        return out
 
 
 def stream_function(sim: Simulation, i0: int = 0, i1: int | None = None, j0: int = 0,
