@@ -192,12 +192,13 @@ def dfg_cells_across(ppd):
 
 
 def dfg(ppd, t_end, threads, scheme, ib_order=1, ny_shift=0, overset=None, body_shift=0.0, unsteady=False,
-        window=3.0, series_out=None):
+        window=3.0, series_out=None, body_extent=1.0):
     """DFG 2D-1 on a uniform grid h = D/ppd; ``ny_shift`` adds cells across the channel (dy =
     0.41/(ny + ny_shift), nearly the same resolution, the cylinder cut differently by the grid).
     ``overset`` = background cells per diameter: the cylinder in a body grid of h = D/ppd spanning
-    +-1 D around it (``bridge.cfd.OversetPair``) over a uniform background of h = D/overset, the body
-    grid shifted by ``body_shift`` of its cells in x and y (the cylinder cut differently).
+    +-``body_extent`` D around it (``bridge.cfd.OversetPair``) over a uniform background of h =
+    D/overset, the body grid shifted by ``body_shift`` of its cells in x and y (the cylinder cut
+    differently).
     ``unsteady``: DFG 2D-2 (U_max = 1.5, Re 100, periodic shedding): c_D,max, c_L,max and St over the
     last ``window``, the force series written to ``series_out`` (.h5 and .png)."""
     d, h_ch, length, nu, umax = DFG_D, DFG_H, 2.2, 1e-3, (1.5 if unsteady else 0.3)
@@ -226,7 +227,8 @@ def dfg(ppd, t_end, threads, scheme, ib_order=1, ny_shift=0, overset=None, body_
         probe, centre, cells, steps = sim, (0.2, 0.2), nx * ny, sim.n_steps
     else:
         sh = body_shift * d / ppd
-        body_grid = CartesianGrid.uniform(2 * ppd, 2 * ppd, (-d + sh, d + sh), (-d + sh, d + sh))
+        n, e = int(round(2 * body_extent * ppd)), body_extent * d
+        body_grid = CartesianGrid.uniform(n, n, (-e + sh, e + sh), (-e + sh, e + sh))
         pair = OversetPair(grid, body_grid, cfg, Stationary(0.2, 0.2), polygon=circle(d))
         pair.background.set_state(u=u0)
         pair.set_initial_state()
@@ -248,6 +250,7 @@ def dfg(ppd, t_end, threads, scheme, ib_order=1, ny_shift=0, overset=None, body_
         sel = t > t[-1] - window
         st, _ = _strouhal(t, cl, window)
         row = {"case": "DFG 2D-2", "ppd": ppd, "overset_background_ppd": overset, "body_shift": body_shift,
+               "body_extent": body_extent if overset else None,
                "cells": cells, "t_end": float(t[-1]), "steps": steps, "wall_s": wall, "window": window,
                "c_D_max": float(cd[sel].max()), "c_L_max": float(cl[sel].max()), "c_L_min": float(cl[sel].min()),
                "St": st * d / um, "band": BANDS["dfg2"]}
@@ -255,6 +258,7 @@ def dfg(ppd, t_end, threads, scheme, ib_order=1, ny_shift=0, overset=None, body_
             _write_series(series_out, t, cd, cl, row)
         return row
     return {"case": "DFG 2D-1", "ppd": ppd, "overset_background_ppd": overset, "body_shift": body_shift,
+            "body_extent": body_extent if overset else None,
             "cells": cells, "nx": nx, "ny": ny,
             "t_end": float(t[-1]), "steps": steps, "wall_s": wall, "blockage": d / h_ch, "advection": scheme,
             "ib_order": ib_order, "ny_shift": ny_shift, "c_D": float(scale * f[-1, 0]),
@@ -369,6 +373,8 @@ def main(argv=None):
     ap.add_argument("--body-shift", type=float, nargs="+", default=[0.0],
                     help="dfg --overset: shift of the body grid against the cylinder, in body-grid cells (the "
                          "overset counterpart of --ny-shift)")
+    ap.add_argument("--body-extent", type=float, default=1.0, metavar="E",
+                    help="dfg, dfg2 --overset: the body grid spans +-E D around the cylinder (default 1)")
     ap.add_argument("--out", default="out/validation_cfd.jsonl")
     args = ap.parse_args(argv)
     wp.config.quiet = True
@@ -387,10 +393,12 @@ def main(argv=None):
                              *args.domain, ib_order=args.ib_order)
             else:
                 stem = Path(args.out).with_name(f"{args.case}_ppd{ppd}" + (f"_bg{args.overset}" if args.overset else "")
-                                                + (f"_shift{variant:g}" if variant else ""))
+                                                + (f"_shift{variant:g}" if variant else "")
+                                                + (f"_ext{args.body_extent:g}" if args.body_extent != 1.0 else ""))
                 r = dfg(ppd, args.t_end, args.threads, args.advection, args.ib_order,
                         0 if args.overset else variant, args.overset, variant if args.overset else 0.0,
-                        unsteady=args.case == "dfg2", window=min(args.window, args.t_end / 2), series_out=stem)
+                        unsteady=args.case == "dfg2", window=min(args.window, args.t_end / 2), series_out=stem,
+                        body_extent=args.body_extent)
             r["command"] = command
             _emit(r, args.out)
             results.append(r)
@@ -404,6 +412,9 @@ def _check_args(ap, args):
               ("--t-end", args.t_end, args.t_end > 0, "> 0"),
               ("--window", args.window, args.window > 0, "> 0"),
               ("--threads", args.threads, args.threads >= 1, ">= 1"),
+              ("--body-extent", args.body_extent, 0.75 <= args.body_extent <= 1.6,
+               "0.75 .. 1.6 D (the body grid must hold the cylinder and the hole, and its fringe must stay clear "
+               "of the channel's wall 2 D from the centre)"),
               ("--domain", args.domain, min(args.domain[:2]) >= 1 and args.domain[2] > 1.5,
                "UPSTREAM, DOWNSTREAM >= 1 D and HALF_HEIGHT > 1.5 D (the refined band is +-1.5 D)")]
     if args.overset is not None:
