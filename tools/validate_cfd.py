@@ -183,6 +183,47 @@ def _march_pair(pair, t_end, label):
     return np.array(t), np.array(f)
 
 
+class ControlVolumeLift:
+    """Lift on a body from the momentum balance of a box of cells around it (a check of the immersed
+    boundary's force, which sums the forcing): F_y = -(dM_y/dt + sum over the box's sides of the
+    outgoing flux of y-momentum, pressure and viscous stress), on a grid uniform near the box. The box
+    is cut along cell faces, ``half`` (a length) around ``centre``; its sides must lie in fluid."""
+
+    def __init__(self, sim, centre, half):
+        g = sim.grid
+        self.hx, self.hy, self.nu = g.dx, float(g.dy[0]), sim.config.nu
+        self.ia, self.ib = (int(round((centre[0] + s * half - g.x_faces[0]) / g.dx)) for s in (-1, 1))
+        self.ja, self.jb = (int(np.searchsorted(g.y_faces, centre[1] + s * half)) for s in (-1, 1))
+        self.sim, self.m_old, self.f = sim, None, []
+
+    def _momentum(self, v):
+        ia, ib, ja, jb = self.ia, self.ib, self.ja, self.jb
+        return self.hx * self.hy * (v[ja + 1:jb, ia:ib].sum() + 0.5 * (v[ja, ia:ib].sum() + v[jb, ia:ib].sum()))
+
+    def _flux(self, u, v, p):
+        ia, ib, ja, jb, hx, hy, nu = self.ia, self.ib, self.ja, self.jb, self.hx, self.hy, self.nu
+        f = 0.0
+        for i, sgn in ((ia, -1), (ib, 1)):   # x = const sides: u v - nu (du/dy + dv/dx), rows ja .. jb-1
+            vf = 0.25 * (v[ja:jb, i - 1] + v[ja:jb, i] + v[ja + 1:jb + 1, i - 1] + v[ja + 1:jb + 1, i])
+            dvdx = 0.5 * ((v[ja:jb, i] - v[ja:jb, i - 1]) + (v[ja + 1:jb + 1, i] - v[ja + 1:jb + 1, i - 1])) / hx
+            dudy = (u[ja + 1:jb + 1, i] - u[ja - 1:jb - 1, i]) / (2 * hy)
+            f += sgn * hy * np.sum(u[ja:jb, i] * vf - nu * (dudy + dvdx))
+        for j, sgn in ((ja, -1), (jb, 1)):   # y = const sides: v v + p - 2 nu dv/dy, columns ia .. ib-1
+            pf = 0.5 * (p[j - 1, ia:ib] + p[j, ia:ib])
+            dvdy = (v[j + 1, ia:ib] - v[j - 1, ia:ib]) / (2 * hy)
+            f += sgn * hx * np.sum(v[j, ia:ib] ** 2 + pf - 2 * nu * dvdy)
+        return f
+
+    def __call__(self, sim):
+        u, v, p = sim.interior()
+        m = self._momentum(v)
+        if self.m_old is not None:
+            self.f.append(-((m - self.m_old) / sim.last_dt + self._flux(u, v, p)))
+        else:
+            self.f.append(np.nan)
+        self.m_old = m
+
+
 DFG_D, DFG_H = 0.1, 0.41  # cylinder diameter, channel height
 
 
@@ -192,7 +233,7 @@ def dfg_cells_across(ppd):
 
 
 def dfg(ppd, t_end, threads, scheme, ib_order=1, ny_shift=0, overset=None, body_shift=0.0, unsteady=False,
-        window=3.0, series_out=None, body_extent=1.0):
+        window=3.0, series_out=None, body_extent=1.0, cv_lift=False):
     """DFG 2D-1 on a uniform grid h = D/ppd; ``ny_shift`` adds cells across the channel (dy =
     0.41/(ny + ny_shift), nearly the same resolution, the cylinder cut differently by the grid).
     ``overset`` = background cells per diameter: the cylinder in a body grid of h = D/ppd spanning
@@ -200,7 +241,8 @@ def dfg(ppd, t_end, threads, scheme, ib_order=1, ny_shift=0, overset=None, body_
     D/overset, the body grid shifted by ``body_shift`` of its cells in x and y (the cylinder cut
     differently).
     ``unsteady``: DFG 2D-2 (U_max = 1.5, Re 100, periodic shedding): c_D,max, c_L,max and St over the
-    last ``window``, the force series written to ``series_out`` (.h5 and .png)."""
+    last ``window``, the force series written to ``series_out`` (.h5 and .png). ``cv_lift`` (single
+    grid): also the lift from a control volume of +-1.5 D (``ControlVolumeLift``)."""
     d, h_ch, length, nu, umax = DFG_D, DFG_H, 2.2, 1e-3, (1.5 if unsteady else 0.3)
 
     def profile(y, t):
@@ -221,7 +263,8 @@ def dfg(ppd, t_end, threads, scheme, ib_order=1, ny_shift=0, overset=None, body_
         sim.bodies = [ImmersedBody(circle(d), Stationary(0.2, 0.2), grid, sim.L, order=ib_order)]
         sim.set_state(u=u0)
         hist, nan = ForceHistory(), NaNMonitor(every=200)
-        run(sim, t_end, [hist, nan])
+        monitors = [hist, nan] + ([ControlVolumeLift(sim, (0.2, 0.2), 1.5 * d)] if cv_lift else [])
+        run(sim, t_end, monitors)
         t, f = hist.array()
         f = f[:, 0, :]
         probe, centre, cells, steps = sim, (0.2, 0.2), nx * ny, sim.n_steps
@@ -254,6 +297,10 @@ def dfg(ppd, t_end, threads, scheme, ib_order=1, ny_shift=0, overset=None, body_
                "cells": cells, "t_end": float(t[-1]), "steps": steps, "wall_s": wall, "window": window,
                "c_D_max": float(cd[sel].max()), "c_L_max": float(cl[sel].max()), "c_L_min": float(cl[sel].min()),
                "St": st * d / um, "band": BANDS["dfg2"]}
+        if cv_lift and overset is None:
+            cl_cv = scale * np.array(monitors[-1].f)
+            row.update(c_L_max_cv=float(cl_cv[sel].max()), c_L_min_cv=float(cl_cv[sel].min()),
+                       c_L_rms_difference_cv=float(np.sqrt(np.mean((cl_cv[sel] - cl[sel]) ** 2))))
         if series_out is not None:
             _write_series(series_out, t, cd, cl, row)
         return row
@@ -375,6 +422,9 @@ def main(argv=None):
                          "overset counterpart of --ny-shift)")
     ap.add_argument("--body-extent", type=float, default=1.0, metavar="E",
                     help="dfg, dfg2 --overset: the body grid spans +-E D around the cylinder (default 1)")
+    ap.add_argument("--cv-lift", action="store_true",
+                    help="dfg2 on the single grid: also the lift from a control-volume momentum balance of +-1.5 D "
+                         "(a check of the immersed boundary's force)")
     ap.add_argument("--out", default="out/validation_cfd.jsonl")
     args = ap.parse_args(argv)
     wp.config.quiet = True
@@ -398,7 +448,7 @@ def main(argv=None):
                 r = dfg(ppd, args.t_end, args.threads, args.advection, args.ib_order,
                         0 if args.overset else variant, args.overset, variant if args.overset else 0.0,
                         unsteady=args.case == "dfg2", window=min(args.window, args.t_end / 2), series_out=stem,
-                        body_extent=args.body_extent)
+                        body_extent=args.body_extent, cv_lift=args.cv_lift)
             r["command"] = command
             _emit(r, args.out)
             results.append(r)
