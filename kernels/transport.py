@@ -117,3 +117,100 @@ def cell_wall_distance(verts: wp.array(dtype=wp.vec2d), x0: wp.float64, dx: wp.f
         d = wp.abs(polygon_signed_distance(c * X + s * Y, -s * X + c * Y, verts))
         dist[j, i] = wp.min(dist[j, i], d)
 
+
+
+# --- k-omega SST, the 2003 variant (Menter, Kuntz and Langtry 2003; NASA TMR "SST-2003") ----------
+SST_BETA_STAR = wp.constant(wp.float64(0.09))
+SST_A1 = wp.constant(wp.float64(0.31))
+SST_SIGMA_K1 = wp.constant(wp.float64(0.85))
+SST_SIGMA_K2 = wp.constant(wp.float64(1.0))
+SST_SIGMA_W1 = wp.constant(wp.float64(0.5))
+SST_SIGMA_W2 = wp.constant(wp.float64(0.856))
+SST_BETA1 = wp.constant(wp.float64(0.075))
+SST_BETA2 = wp.constant(wp.float64(0.0828))
+SST_GAMMA1 = wp.constant(wp.float64(5.0 / 9.0))
+SST_GAMMA2 = wp.constant(wp.float64(0.44))
+
+
+@wp.func
+def _fill_ghosts(a: wp.array2d(dtype=wp.float64), J: int, g: int, nx: int, ny: int):
+    """Ghost columns of row J from its edge cells; the first (last) interior row also fills the
+    ghost rows below (above) it, corners included."""
+    for m in range(1, g + 1):
+        a[J, g - m] = a[J, g]
+        a[J, g + nx - 1 + m] = a[J, g + nx - 1]
+    if J == g:
+        for m in range(1, g + 1):
+            for I in range(0, nx + 2 * g):
+                a[g - m, I] = a[g, I]
+    if J == g + ny - 1:
+        for m in range(1, g + 1):
+            for I in range(0, nx + 2 * g):
+                a[g + ny - 1 + m, I] = a[g + ny - 1, I]
+
+
+@wp.kernel
+def sst_coefficients(u: wp.array2d(dtype=wp.float64), v: wp.array2d(dtype=wp.float64),
+                     k: wp.array2d(dtype=wp.float64), w: wp.array2d(dtype=wp.float64),
+                     dist: wp.array2d(dtype=wp.float64), nu: wp.float64,
+                     hy_c: wp.array(dtype=wp.float64), yc: wp.array(dtype=wp.float64), dx: wp.float64,
+                     g: int, nx: int, ny: int, row0: int,
+                     nu_eff: wp.array2d(dtype=wp.float64), gam_k: wp.array2d(dtype=wp.float64),
+                     gam_w: wp.array2d(dtype=wp.float64), src_k: wp.array2d(dtype=wp.float64),
+                     snk_k: wp.array2d(dtype=wp.float64), src_w: wp.array2d(dtype=wp.float64),
+                     snk_w: wp.array2d(dtype=wp.float64)):
+    """The SST-2003 model's coefficients on the cells of storage row row0 + tid (and that row's ghost
+    columns; the first and last interior rows also fill the ghost rows), for the transport of
+    ``kernels.transport.scalar_stage`` (bridge/cfd/turbulence.py has the equations):
+    nu_eff = nu + nu_t; k: Gamma = nu + sigma_k nu_t, S_e = min(nu_t S^2, 10 beta* k omega),
+    S_i = beta* omega; omega: Gamma = nu + sigma_w nu_t, S_e = gamma S^2 + max(CD, 0),
+    S_i = beta omega + max(-CD, 0) / omega, CD = 2 (1 - F1) sigma_w2 grad k . grad omega / omega."""
+    J = row0 + wp.tid()
+    half = wp.float64(0.5)
+    one = wp.float64(1.0)
+    two = wp.float64(2.0)
+    tiny = wp.float64(1.0e-30)
+    idx = one / dx
+    ihc = one / hy_c[J]
+    iyy = one / (yc[J + 1] - yc[J - 1])
+    for I in range(g, g + nx):
+        dudx = (u[J, I + 1] - u[J, I]) * idx
+        dvdy = (v[J + 1, I] - v[J, I]) * ihc
+        dudy = half * ((u[J + 1, I] + u[J + 1, I + 1]) - (u[J - 1, I] + u[J - 1, I + 1])) * iyy
+        dvdx = half * ((v[J, I + 1] + v[J + 1, I + 1]) - (v[J, I - 1] + v[J + 1, I - 1])) * half * idx
+        s2 = two * (dudx * dudx + dvdy * dvdy) + (dudy + dvdx) * (dudy + dvdx)
+        kk = wp.max(k[J, I], wp.float64(0.0))
+        ww = wp.max(w[J, I], tiny)
+        d = dist[J, I]
+        dkx = (k[J, I + 1] - k[J, I - 1]) * half * idx
+        dky = (k[J + 1, I] - k[J - 1, I]) * iyy
+        dwx = (w[J, I + 1] - w[J, I - 1]) * half * idx
+        dwy = (w[J + 1, I] - w[J - 1, I]) * iyy
+        grad_kw = dkx * dwx + dky * dwy
+        cd_kw = wp.max(two * SST_SIGMA_W2 * grad_kw / ww, wp.float64(1.0e-10))
+        sk = wp.sqrt(kk)
+        arg1 = wp.min(wp.max(sk / (SST_BETA_STAR * ww * d), wp.float64(500.0) * nu / (d * d * ww)),
+                      wp.float64(4.0) * SST_SIGMA_W2 * kk / (cd_kw * d * d))
+        f1 = wp.tanh(arg1 * arg1 * arg1 * arg1)
+        arg2 = wp.max(two * sk / (SST_BETA_STAR * ww * d), wp.float64(500.0) * nu / (d * d * ww))
+        f2 = wp.tanh(arg2 * arg2)
+        nut = SST_A1 * kk / wp.max(SST_A1 * ww, wp.sqrt(s2) * f2)
+        sigma_k = f1 * SST_SIGMA_K1 + (one - f1) * SST_SIGMA_K2
+        sigma_w = f1 * SST_SIGMA_W1 + (one - f1) * SST_SIGMA_W2
+        beta = f1 * SST_BETA1 + (one - f1) * SST_BETA2
+        gamma = f1 * SST_GAMMA1 + (one - f1) * SST_GAMMA2
+        cross = two * (one - f1) * SST_SIGMA_W2 * grad_kw / ww
+        nu_eff[J, I] = nu + nut
+        gam_k[J, I] = nu + sigma_k * nut
+        gam_w[J, I] = nu + sigma_w * nut
+        src_k[J, I] = wp.min(nut * s2, wp.float64(10.0) * SST_BETA_STAR * kk * ww)
+        snk_k[J, I] = SST_BETA_STAR * ww
+        src_w[J, I] = gamma * s2 + wp.max(cross, wp.float64(0.0))
+        snk_w[J, I] = beta * ww + wp.max(-cross, wp.float64(0.0)) / ww
+    _fill_ghosts(nu_eff, J, g, nx, ny)
+    _fill_ghosts(gam_k, J, g, nx, ny)
+    _fill_ghosts(gam_w, J, g, nx, ny)
+    _fill_ghosts(src_k, J, g, nx, ny)
+    _fill_ghosts(snk_k, J, g, nx, ny)
+    _fill_ghosts(src_w, J, g, nx, ny)
+    _fill_ghosts(snk_w, J, g, nx, ny)

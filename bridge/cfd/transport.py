@@ -106,17 +106,20 @@ class TransportedScalar:
     # --- time step ----------------------------------------------------------------------------
     def stable_dt(self, u=None, v=None) -> float:
         """The largest dt for which a step keeps q non-negative and bounded: advection and diffusion
-        together, 1 / (rate_adv / cfl + rate_diff / (2 fourier)) with rate_adv = |u|/dx + |v|/dy and
-        rate_diff = 2 Gamma (1/dx^2 + 1/dy^2) (forward Euler, each stage; ``FlowConfig.cfl`` and
-        ``fourier``), for the velocity (u, v) (default: the flow's) and this scalar's Gamma."""
+        together, cell by cell, 1 / max(rate_adv / cfl + rate_diff / (2 fourier)) with rate_adv =
+        |u|/dx + |v|/dy and rate_diff = 2 Gamma (1/dx^2 + 1/dy^2) (forward Euler, each stage;
+        ``FlowConfig.cfl`` and ``fourier``), for the velocity (u, v) (default: the flow's) and this
+        scalar's Gamma."""
         cfg, grid = self.sim.config, self.sim.grid
-        u = self.sim.u if u is None else u
-        v = self.sim.v if v is None else v
-        hy = float(grid.dy.min())
-        rate = np.abs(u.numpy()).max() / grid.dx + np.abs(v.numpy()).max() / hy
-        diff = 2.0 * float(self.gamma.numpy().max()) * (1.0 / grid.dx ** 2 + 1.0 / hy ** 2)
-        total = rate / cfg.cfl + diff / (2.0 * cfg.fourier)
-        return float(1.0 / total) if total > 0 else float("inf")
+        g, nx, ny = GHOST, grid.nx, grid.ny
+        u = (self.sim.u if u is None else u).numpy()[g:g + ny, g:g + nx + 1]
+        v = (self.sim.v if v is None else v).numpy()[g:g + ny + 1, g:g + nx]
+        dy = grid.dy[:, None]
+        adv = np.maximum(np.abs(u[:, :-1]), np.abs(u[:, 1:])) / grid.dx \
+            + np.maximum(np.abs(v[:-1]), np.abs(v[1:])) / dy
+        diff = 2.0 * self.gamma.numpy()[g:g + ny, g:g + nx] * (1.0 / grid.dx ** 2 + 1.0 / dy ** 2)
+        total = float(np.max(adv / cfg.cfl + diff / (2.0 * cfg.fourier)))
+        return 1.0 / total if total > 0 else float("inf")
 
     def advance(self, dt: float, u=None, v=None) -> None:
         """One step of the flow's time scheme with the velocity (u, v) (default: the flow's current

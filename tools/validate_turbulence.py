@@ -1,0 +1,142 @@
+"""Checks of the k-omega SST model (bridge/cfd/turbulence.py, the 2003 variant); not in the test run.
+
+    python tools/validate_turbulence.py decay                # closed form, first order in dt
+    python tools/validate_turbulence.py channel --re-tau 395 # fully developed channel vs the log law
+
+decay: homogeneous turbulence at rest (no walls: F1 = 0, the outer constants), k0 = 0.01, omega0 = 1,
+to t = 4 with dt = 0.02, 0.01, 0.005. Closed form: omega = omega0 / (1 + beta_2 omega0 t),
+k = k0 (1 + beta_2 omega0 t)^(-beta*/beta_2).
+
+channel: the fully developed plane channel (walls at y = 0 and 2, half-height h = 1, u_tau = 1, nu =
+1/Re_tau, driven by dp/dx = -1) as a column of cells: the SST model's k and omega carried by the
+library's transport and coefficient kernels on a 4-column grid with no variation in x, the mean
+momentum d/dy((nu + nu_t) dU/dy) + 1 = 0 marched implicitly in pseudo-time (a tridiagonal solve per
+step; the 2D solver has no periodic sides). Grid: 64 cells across, tanh-clustered (first cell centre
+at y+ = 1), marched to t = 8 h/u_tau (steady: the wall shear balances the driving gradient to 0.1 %).
+Reported: U+ against y+ beside the log law U+ = ln(y+)/0.41 + 5.0 (TMR's constants), U_b+ and U_c+.
+Results are appended to ``--out`` as JSON lines.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+from scipy.linalg import solve_banded
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+import warp as wp  # noqa: E402
+
+from bridge.cfd import BoundaryConditions, CartesianGrid, FlowConfig, Simulation  # noqa: E402
+from bridge.cfd.grids import GHOST  # noqa: E402
+from bridge.cfd.turbulence import KOmegaSST  # noqa: E402
+
+KAPPA, B = 0.41, 5.0
+BETA_STAR, BETA_2 = 0.09, 0.0828
+
+
+def decay(dts=(0.02, 0.01, 0.005), t_end=4.0, k0=0.01, omega0=1.0):
+    grid = CartesianGrid.uniform(8, 8, (0.0, 1.0), (0.0, 1.0))
+    omega_exact = omega0 / (1 + BETA_2 * omega0 * t_end)
+    k_exact = k0 * (1 + BETA_2 * omega0 * t_end) ** (-BETA_STAR / BETA_2)
+    rows = []
+    for dt in dts:
+        sim = Simulation(grid, FlowConfig(nu=1e-3, threads=1, bc=BoundaryConditions(left="slip", right="slip")))
+        model = KOmegaSST(sim, k0, omega0)
+        for _ in range(int(round(t_end / dt))):
+            model.advance(dt)
+        rows.append({"dt": dt, "k_error": float(model.k.interior().mean() / k_exact - 1),
+                     "omega_error": float(model.omega.interior().mean() / omega_exact - 1),
+                     "spread": float(np.ptp(model.k.interior()))})
+    return {"case": "SST decay", "t_end": t_end, "k_exact": k_exact, "omega_exact": omega_exact, "runs": rows}
+
+
+def channel(re_tau=395.0, n=64, stretch=2.0, t_end=8.0, progress=None):
+    """The column channel (module doc); returns (y centres, U, u_tau from the wall shear, nu, model)."""
+    nu = 1.0 / re_tau
+    y = 1 - np.tanh(stretch * (1 - 2 * np.linspace(0.0, 1.0, n + 1))) / np.tanh(stretch)
+    grid = CartesianGrid(np.linspace(0.0, 0.1, 5), y)
+    sim = Simulation(grid, FlowConfig(nu=nu, threads=1, bc=BoundaryConditions(left="slip", right="slip",
+                                                                              bottom="noslip", top="noslip")))
+    g, yc, dy = GHOST, grid.y_centres, grid.dy
+    # start: Reichardt's profile and an equilibrium-like k, omega (any reasonable start converges)
+    yw = np.minimum(yc, 2 - yc) * re_tau
+    u = np.log(1 + KAPPA * yw) / KAPPA + 7.8 * (1 - np.exp(-yw / 11) - yw / 11 * np.exp(-yw / 3))
+    k = (1 - np.exp(-yw / 20)) ** 2 / np.sqrt(BETA_STAR) + 1e-6
+    omega = np.sqrt(k) / (BETA_STAR ** 0.25 * KAPPA * np.minimum(yc, 2 - yc))
+    model = KOmegaSST(sim, 1e-6, 1.0)
+    model.k.set(np.repeat(k[:, None], 4, 1))
+    model.omega.set(np.repeat(omega[:, None], 4, 1))
+    hu = sim.u.numpy()   # the flow's u, a view on the CPU
+    dc = np.concatenate(([yc[0] - y[0]], np.diff(yc), [y[-1] - yc[-1]]))   # centre-to-centre (wall: to the wall)
+    t, steps = 0.0, 0
+    while t < t_end:
+        hu[g:g + n, :] = u[:, None]
+        model.update()
+        dt = model.stable_dt()
+        nu_eff = sim.nu.numpy()[g:g + n, g]
+        nf = np.concatenate(([nu_eff[0]], 0.5 * (nu_eff[1:] + nu_eff[:-1]), [nu_eff[-1]]))
+        a = nf / dc
+        bands = np.zeros((3, n))
+        bands[0, 1:] = -a[1:-1]
+        bands[1] = dy / dt + a[:-1] + a[1:]
+        bands[2, :-1] = -a[1:-1]
+        u = solve_banded((1, 1), bands, dy / dt * u + dy * 1.0)
+        model.k.advance(dt)
+        model.omega.advance(dt)
+        t += dt
+        steps += 1
+        if progress and steps % 5000 == 0:
+            progress(t, t_end)
+    u_tau = float(np.sqrt(nu_eff[0] * u[0] / (yc[0] - y[0])))
+    return yc, u, u_tau, nu, model, steps
+
+
+def channel_report(re_tau=395.0, t_end=8.0):
+    t0 = time.perf_counter()
+
+    def progress(t, t_end):
+        print(f"  t = {t:.2f} of {t_end:g} h/u_tau", file=sys.stderr, flush=True)
+
+    yc, u, u_tau, nu, model, steps = channel(re_tau, t_end=t_end, progress=progress)
+    half = yc < 1
+    yp, up = yc[half] * u_tau / nu, u[half] / u_tau
+    log = np.log(yp) / KAPPA + B
+    band = (yp >= 30) & (yp <= 100)
+    dy = model.sim.grid.dy
+    return {"case": "SST channel", "re_tau": re_tau, "cells_across": int(yc.size), "t_end": t_end,
+            "steps": steps, "wall_s": time.perf_counter() - t0, "u_tau_from_wall_shear": u_tau,
+            "U_b+": float(np.sum(u * dy) / 2 / u_tau), "U_c+": float(up.max()),
+            "y+": yp.tolist(), "U+": up.tolist(),
+            "log_law_deviation_30_100": float(np.max(np.abs(up[band] / log[band] - 1))),
+            "first_cell": {"y+": float(yp[0]), "U+": float(up[0])}}
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("case", choices=["decay", "channel"])
+    ap.add_argument("--re-tau", type=float, default=395.0)
+    ap.add_argument("--t-end", type=float, default=8.0, help="channel: pseudo-time in h/u_tau")
+    ap.add_argument("--out", default="out/validation_turbulence.jsonl")
+    args = ap.parse_args(argv)
+    if not 100 <= args.re_tau <= 2000:
+        ap.error(f"--re-tau: {args.re_tau} not allowed; allowed: 100 .. 2000 (64 cells across)")
+    if not args.t_end > 0:
+        ap.error(f"--t-end: {args.t_end} not allowed; allowed: > 0")
+    wp.config.quiet = True
+    r = decay() if args.case == "decay" else channel_report(args.re_tau, args.t_end)
+    r["command"] = "python tools/validate_turbulence.py " + " ".join(argv if argv is not None else sys.argv[1:])
+    print(json.dumps({k: v for k, v in r.items() if k not in ("y+", "U+")}), flush=True)
+    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+    with open(args.out, "a") as fh:
+        fh.write(json.dumps(r) + "\n")
+    return r
+
+
+if __name__ == "__main__":
+    main()
