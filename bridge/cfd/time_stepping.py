@@ -156,6 +156,7 @@ class Simulation:
         self.n_steps = 0
         self.last_force = [np.zeros(3) for _ in self.bodies]
         self.nu_max = config.nu
+        self.nu_rows = None   # largest nu of each cell row (ny,), where a viscosity field sets it (stable_dt)
         self.last_dt = 0.0
 
     def add_body(self, polygon, motion, margin: int = 3):
@@ -200,6 +201,7 @@ class Simulation:
                              f"got shape {host.shape}")
         self.nu.assign(host)
         self.nu_max = float(host.max())
+        self.nu_rows = host[g:g + ny, g:g + nx].max(axis=1)
 
     # --- initialisation ---------------------------------------------------------------------------
     def set_state(self, u=None, v=None, p=None, t: float = 0.0):
@@ -260,7 +262,11 @@ class Simulation:
             + (np.maximum(v.max(axis=1), -v.min(axis=1)) / self._hf_inner).max()
         if not np.isfinite(rate):  # non-finite fields: the viscous limit; a NaNMonitor, if attached, stops the run
             rate = 0.0
-        inv_dt = rate / c.cfl + self.nu_max / (c.fourier * h * h)
+        if self.nu_rows is None:
+            viscous = self.nu_max / (c.fourier * h * h)
+        else:   # a viscosity field (a turbulence model): each row's largest nu over its own spacing
+            viscous = float(np.max(self.nu_rows / np.minimum(self.grid.dx, self.grid.dy) ** 2)) / c.fourier
+        inv_dt = rate / c.cfl + viscous
         return float(min(1.0 / inv_dt, c.dt_max))
 
     def _predict(self, src_u, src_v, u0, v0, dt, a, b):

@@ -91,7 +91,9 @@ class KOmegaSST:
         sim.L.rows(_t.sst_coefficients, grid.ny, g,
                    [sim.u, sim.v, k.q, w.q, self._dist, self.nu, sim.hy_c, self._yc, grid.dx, g, grid.nx,
                     grid.ny, ROW0, sim.nu, k.gamma, w.gamma, k.source, k.sink, w.source, w.sink])
-        sim.nu_max = float(sim.nu.numpy().max())
+        nu = sim.nu.numpy()[g:g + grid.ny, g:g + grid.nx]
+        sim.nu_rows = nu.max(axis=1)
+        sim.nu_max = float(sim.nu_rows.max())
 
     def stable_dt(self) -> float:
         return min(self.k.stable_dt(), self.omega.stable_dt())
