@@ -21,7 +21,8 @@ Discretisation: k and omega are ``TransportedScalar``s (kernels/transport.py: co
 advection relative to the grid, positivity kept); the coefficients come from one Warp kernel
 (``kernels.transport.sst_coefficients``), destruction terms implicit. The model is advanced after the
 flow's step with that step's velocity (segregated) and hands nu + nu_t to the flow
-(``Simulation.nu``, the plug-in point of the momentum stress).
+(``Simulation.nu``, the plug-in point of the momentum stress), computed once per step from the new
+velocity and the k, omega of the step's start.
 
 Boundaries: an inflow side takes the freestream (k_inf, omega_inf); an outflow or slip side zero
 gradient; a no-slip side k = 0 and omega = 60 nu / (beta_1 dy_1^2) on the wall (dy_1 the height of
@@ -96,15 +97,25 @@ class KOmegaSST:
         sim.nu_max = float(sim.nu_rows.max())
 
     def stable_dt(self) -> float:
-        return min(self.k.stable_dt(), self.omega.stable_dt())
+        """The transport's limit for k and omega, from each row's largest diffusivity and the largest
+        velocities (cheaper than ``TransportedScalar.stable_dt``'s cell by cell, and no larger)."""
+        cfg, grid, g = self.sim.config, self.sim.grid, GHOST
+        rows = slice(g, g + grid.ny), slice(g, g + grid.nx)
+        gamma = np.maximum(self.k.gamma.numpy()[rows].max(axis=1), self.omega.gamma.numpy()[rows].max(axis=1))
+        u = self.sim.u.numpy()[rows[0], g:g + grid.nx + 1]
+        v = self.sim.v.numpy()[g:g + grid.ny + 1, rows[1]]
+        adv = max(u.max(), -u.min()) / grid.dx + max(v.max(), -v.min()) / float(grid.dy.min())
+        diff = float(np.max(2.0 * gamma * (1.0 / grid.dx ** 2 + 1.0 / grid.dy ** 2)))
+        total = adv / cfg.cfl + diff / (2.0 * cfg.fourier)
+        return 1.0 / total if total > 0 else float("inf")
 
     def advance(self, dt: float) -> None:
-        """k and omega over dt with the flow's current velocity (call after the flow's step), then the
-        flow's nu + nu_t for its next step."""
+        """k and omega over dt (call after the flow's step): the coefficients and the flow's nu + nu_t
+        from the flow's new velocity and the k, omega at the step's start (one coefficient pass per
+        step; the flow's next step sees nu_t lagged by that step, as in any segregated scheme)."""
         self.update()
         self.k.advance(dt)
         self.omega.advance(dt)
-        self.update()
 
     def nu_t(self) -> np.ndarray:
         """(ny, nx) eddy viscosity of the current state."""

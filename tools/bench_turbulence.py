@@ -1,0 +1,85 @@
+"""Benchmark: what the k-omega SST model (bridge/cfd/turbulence.py) adds to the cost of a time step.
+
+    python tools/bench_turbulence.py                  # 512 x 256 cells
+    python tools/bench_turbulence.py --size 1024x512 --steps 20 --repeats 5
+
+Method: a channel (inflow, outflow, no-slip walls) in a developing state, a fixed dt; blocks of
+``--steps`` steps timed alternately: (a) the laminar step (``Simulation.step``), (b) the same step
+followed by ``KOmegaSST.advance`` (the coefficient kernel twice, k and omega over the two stages, their
+ghosts). The ratio (b)/(a) is the median over blocks in one run (the machine is shared: ratios, not
+absolute times, are comparable across runs). Issue 17's target: at most 2x.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+import warp as wp  # noqa: E402
+
+from bridge.cfd import BoundaryConditions, CartesianGrid, FlowConfig, Simulation  # noqa: E402
+from bridge.cfd.turbulence import KOmegaSST, freestream_turbulence  # noqa: E402
+
+
+def _shape(text: str) -> tuple[int, int]:
+    nx, ny = (int(v) for v in text.lower().split("x"))
+    if nx < 16 or ny < 16:
+        raise argparse.ArgumentTypeError(f"{text}: need at least 16 x 16 cells")
+    return nx, ny
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--size", type=_shape, default=(512, 256))
+    ap.add_argument("--steps", type=int, default=20)
+    ap.add_argument("--repeats", type=int, default=5)
+    ap.add_argument("--json", type=Path, default=None)
+    args = ap.parse_args(argv)
+    wp.config.quiet = True
+    nx, ny = args.size
+    nu = 1e-4
+    grid = CartesianGrid.uniform(nx, ny, (0.0, 4.0), (0.0, 2.0))
+    sim = Simulation(grid, FlowConfig(nu=nu, bc=BoundaryConditions(left="inflow", right="outflow", bottom="noslip",
+                                                                   top="noslip")))
+    sim.set_state(u=1.0)
+    model = KOmegaSST(sim, *freestream_turbulence(1.0, nu, 0.05, 10.0))
+    dt = 0.5 * min(sim.stable_dt(), model.stable_dt())
+    for _ in range(20):
+        sim.step(dt)
+        model.advance(dt)
+    flow, both = [], []
+    for _ in range(args.repeats):
+        t0 = time.perf_counter()
+        for _ in range(args.steps):
+            sim.step(dt)
+        flow.append((time.perf_counter() - t0) / args.steps)
+        t0 = time.perf_counter()
+        for _ in range(args.steps):
+            sim.step(dt)
+            model.advance(dt)
+        both.append((time.perf_counter() - t0) / args.steps)
+    cells = nx * ny
+    ratio = float(np.median(np.array(both) / np.array(flow)))
+    tf, tb = float(np.median(flow)), float(np.median(both))
+    row = {"size": [nx, ny], "cells": cells, "laminar_ms_per_step": 1e3 * tf, "sst_ms_per_step": 1e3 * tb,
+           "laminar_M_cell_steps_s": cells / tf / 1e6, "sst_M_cell_steps_s": cells / tb / 1e6, "ratio": ratio,
+           "finite": bool(np.isfinite(model.nu_t()).all())}
+    print(f"{nx} x {ny} = {cells} cells")
+    for label, sec in (("laminar step", tf), ("step + SST", tb)):
+        print(f"  {label:<13} {1e3 * sec:.2f} ms/step  {cells / sec / 1e6:.2f} M cell-steps/s")
+    print(f"  SST cost factor {ratio:.2f} (median of {args.repeats} block ratios; target <= 2)")
+    if args.json:
+        args.json.parent.mkdir(parents=True, exist_ok=True)
+        args.json.write_text(json.dumps(row))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
