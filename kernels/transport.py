@@ -21,6 +21,33 @@ import warp as wp
 from kernels.cfd import polygon_signed_distance, upwind_flux
 
 
+@wp.func
+def _xflux(q: wp.array2d(dtype=wp.float64), gam: wp.array2d(dtype=wp.float64), vel: wp.float64, J: int, I: int,
+           idx: wp.float64, scheme: int):
+    """Advective minus diffusive flux of q through the face between cells (J, I - 1) and (J, I)."""
+    half = wp.float64(0.5)
+    one = wp.float64(1.0)
+    return upwind_flux(vel, q[J, I - 2], q[J, I - 1], q[J, I], q[J, I + 1], one, one, half, scheme) \
+        - half * (gam[J, I - 1] + gam[J, I]) * (q[J, I] - q[J, I - 1]) * idx
+
+
+@wp.func
+def _yflux(q: wp.array2d(dtype=wp.float64), gam: wp.array2d(dtype=wp.float64), vel: wp.float64, J: int, I: int,
+           rm: wp.float64, rp: wp.float64, w: wp.float64, ihf: wp.float64, scheme: int):
+    """The same through the face between cells (J - 1, I) and (J, I) (spacing ratios rm, rp, weight w,
+    1 / centre distance ihf)."""
+    return upwind_flux(vel, q[J - 2, I], q[J - 1, I], q[J, I], q[J + 1, I], rm, rp, w, scheme) \
+        - wp.float64(0.5) * (gam[J - 1, I] + gam[J, I]) * (q[J, I] - q[J - 1, I]) * ihf
+
+
+@wp.func
+def _stage_value(q: wp.array2d(dtype=wp.float64), q0: wp.array2d(dtype=wp.float64),
+                 s_e: wp.array2d(dtype=wp.float64), s_i: wp.array2d(dtype=wp.float64), J: int, I: int,
+                 div_flux: wp.float64, dt: wp.float64, a: wp.float64, b: wp.float64):
+    """(a q0 + b (q + dt (-div flux + S_e))) / (1 + b dt S_i) at cell (J, I)."""
+    return (a * q0[J, I] + b * (q[J, I] + dt * (s_e[J, I] - div_flux))) / (wp.float64(1.0) + b * dt * s_i[J, I])
+
+
 @wp.kernel
 def scalar_stage(q: wp.array2d(dtype=wp.float64), u: wp.array2d(dtype=wp.float64),
                  v: wp.array2d(dtype=wp.float64), gam: wp.array2d(dtype=wp.float64),
@@ -33,7 +60,7 @@ def scalar_stage(q: wp.array2d(dtype=wp.float64), u: wp.array2d(dtype=wp.float64
     """One stage (module doc) on the cells of storage row row0 + tid, columns i_lo .. i_hi - 1.
 
     ``gx_c[J]``: the grid's x-velocity at the height of row J; ``gy_c[I]``: its y-velocity at the x
-    of column I (zeros for a fixed grid)."""
+    of column I (zeros for a fixed grid). The x-flux is carried along the row."""
     J = row0 + wp.tid()
     half = wp.float64(0.5)
     one = wp.float64(1.0)
@@ -47,22 +74,64 @@ def scalar_stage(q: wp.array2d(dtype=wp.float64), u: wp.array2d(dtype=wp.float64
     rm_hi = hy_f[J + 1] / hy_f[J]
     rp_hi = hy_f[J + 1] / hy_f[J + 2]
     w_hi = half * hy_c[J] / hy_f[J + 1]
-    # the x-flux through the left face of the first cell, then carried along the row
-    I = i_lo
-    fl = upwind_flux(u[J, I] - gx, q[J, I - 2], q[J, I - 1], q[J, I], q[J, I + 1], one, one, half, scheme) \
-        - half * (gam[J, I - 1] + gam[J, I]) * (q[J, I] - q[J, I - 1]) * idx
+    ihf_lo = one / hy_f[J]
+    ihf_hi = one / hy_f[J + 1]
+    fl = _xflux(q, gam, u[J, i_lo] - gx, J, i_lo, idx, scheme)
     for I in range(i_lo, i_hi):
-        fr = upwind_flux(u[J, I + 1] - gx, q[J, I - 1], q[J, I], q[J, I + 1], q[J, I + 2], one, one, half, scheme) \
-            - half * (gam[J, I] + gam[J, I + 1]) * (q[J, I + 1] - q[J, I]) * idx
         gy = gy_c[I]
-        fb = upwind_flux(v[J, I] - gy, q[J - 2, I], q[J - 1, I], q[J, I], q[J + 1, I], rm_lo, rp_lo, w_lo, scheme) \
-            - half * (gam[J - 1, I] + gam[J, I]) * (q[J, I] - q[J - 1, I]) / hy_f[J]
-        ft = upwind_flux(v[J + 1, I] - gy, q[J - 1, I], q[J, I], q[J + 1, I], q[J + 2, I], rm_hi, rp_hi, w_hi,
-                         scheme) \
-            - half * (gam[J, I] + gam[J + 1, I]) * (q[J + 1, I] - q[J, I]) / hy_f[J + 1]
-        rhs = -(fr - fl) * idx - (ft - fb) * ihc + s_e[J, I]
-        out[J, I] = (a * q0[J, I] + b * (q[J, I] + dt * rhs)) / (one + b * dt * s_i[J, I])
+        fr = _xflux(q, gam, u[J, I + 1] - gx, J, I + 1, idx, scheme)
+        fb = _yflux(q, gam, v[J, I] - gy, J, I, rm_lo, rp_lo, w_lo, ihf_lo, scheme)
+        ft = _yflux(q, gam, v[J + 1, I] - gy, J + 1, I, rm_hi, rp_hi, w_hi, ihf_hi, scheme)
+        out[J, I] = _stage_value(q, q0, s_e, s_i, J, I, (fr - fl) * idx + (ft - fb) * ihc, dt, a, b)
         fl = fr
+
+
+@wp.kernel
+def scalar_pair_stage(q1: wp.array2d(dtype=wp.float64), gam1: wp.array2d(dtype=wp.float64),
+                      se1: wp.array2d(dtype=wp.float64), si1: wp.array2d(dtype=wp.float64),
+                      q01: wp.array2d(dtype=wp.float64), out1: wp.array2d(dtype=wp.float64),
+                      q2: wp.array2d(dtype=wp.float64), gam2: wp.array2d(dtype=wp.float64),
+                      se2: wp.array2d(dtype=wp.float64), si2: wp.array2d(dtype=wp.float64),
+                      q02: wp.array2d(dtype=wp.float64), out2: wp.array2d(dtype=wp.float64),
+                      u: wp.array2d(dtype=wp.float64), v: wp.array2d(dtype=wp.float64),
+                      hy_c: wp.array(dtype=wp.float64), hy_f: wp.array(dtype=wp.float64),
+                      gx_c: wp.array(dtype=wp.float64), gy_c: wp.array(dtype=wp.float64),
+                      dx: wp.float64, dt: wp.float64, a: wp.float64, b: wp.float64,
+                      i_lo: int, i_hi: int, row0: int, scheme: int):
+    """``scalar_stage`` for two scalars carried by the same velocity in one sweep (k and omega): the
+    velocity and the metrics are read once for both."""
+    J = row0 + wp.tid()
+    half = wp.float64(0.5)
+    one = wp.float64(1.0)
+    idx = one / dx
+    ihc = one / hy_c[J]
+    gx = gx_c[J]
+    rm_lo = hy_f[J] / hy_f[J - 1]
+    rp_lo = hy_f[J] / hy_f[J + 1]
+    w_lo = half * hy_c[J - 1] / hy_f[J]
+    rm_hi = hy_f[J + 1] / hy_f[J]
+    rp_hi = hy_f[J + 1] / hy_f[J + 2]
+    w_hi = half * hy_c[J] / hy_f[J + 1]
+    ihf_lo = one / hy_f[J]
+    ihf_hi = one / hy_f[J + 1]
+    ul = u[J, i_lo] - gx
+    fl1 = _xflux(q1, gam1, ul, J, i_lo, idx, scheme)
+    fl2 = _xflux(q2, gam2, ul, J, i_lo, idx, scheme)
+    for I in range(i_lo, i_hi):
+        gy = gy_c[I]
+        ur = u[J, I + 1] - gx
+        vb = v[J, I] - gy
+        vt = v[J + 1, I] - gy
+        fr1 = _xflux(q1, gam1, ur, J, I + 1, idx, scheme)
+        fr2 = _xflux(q2, gam2, ur, J, I + 1, idx, scheme)
+        d1 = (fr1 - fl1) * idx + (_yflux(q1, gam1, vt, J + 1, I, rm_hi, rp_hi, w_hi, ihf_hi, scheme)
+                                  - _yflux(q1, gam1, vb, J, I, rm_lo, rp_lo, w_lo, ihf_lo, scheme)) * ihc
+        d2 = (fr2 - fl2) * idx + (_yflux(q2, gam2, vt, J + 1, I, rm_hi, rp_hi, w_hi, ihf_hi, scheme)
+                                  - _yflux(q2, gam2, vb, J, I, rm_lo, rp_lo, w_lo, ihf_lo, scheme)) * ihc
+        out1[J, I] = _stage_value(q1, q01, se1, si1, J, I, d1, dt, a, b)
+        out2[J, I] = _stage_value(q2, q02, se2, si2, J, I, d2, dt, a, b)
+        fl1 = fr1
+        fl2 = fr2
 
 
 @wp.kernel

@@ -26,7 +26,7 @@ from .grids import GHOST
 from .launch import ROW0
 from .precision import DTYPE, WP_DTYPE
 
-__all__ = ["TransportedScalar", "wall_distance"]
+__all__ = ["TransportedScalar", "advance_pair", "wall_distance"]
 
 _SIDES = ("left", "right", "bottom", "top")
 
@@ -138,6 +138,32 @@ class TransportedScalar:
             self.fill_ghosts(out)
             src = out
         self.q, self._next = self._next, self.q
+
+
+def advance_pair(first: TransportedScalar, second: TransportedScalar, dt: float, u=None, v=None) -> None:
+    """``advance`` of two scalars on the same flow in one sweep per stage (k and omega): the same
+    numbers as advancing each alone (``kernels.transport.scalar_pair_stage``), the velocity read once."""
+    sim, g = first.sim, GHOST
+    if second.sim is not sim:
+        raise ValueError("advance_pair: both scalars must live on the same Simulation")
+    grid = sim.grid
+    u = sim.u if u is None else u
+    v = sim.v if v is None else v
+    src1, src2 = first.q, second.q
+    for k, (a, b) in enumerate(sim.stages):
+        last = k == len(sim.stages) - 1
+        out1 = first._next if last else first._stage
+        out2 = second._next if last else second._stage
+        sim.L.rows(_t.scalar_pair_stage, grid.ny, g,
+                   [src1, first.gamma, first.source, first.sink, first.q, out1,
+                    src2, second.gamma, second.source, second.sink, second.q, out2,
+                    u, v, sim.hy_c, sim.hy_f, sim.frame_x, sim.frame_y, grid.dx, float(dt), float(a), float(b),
+                    g, g + grid.nx, ROW0, sim.scheme])
+        first.fill_ghosts(out1)
+        second.fill_ghosts(out2)
+        src1, src2 = out1, out2
+    first.q, first._next = first._next, first.q
+    second.q, second._next = second._next, second.q
 
 
 def wall_distance(grid, polygons=(), pose=(0.0, 0.0, 0.0), walls=(), device: str | None = None) -> np.ndarray:

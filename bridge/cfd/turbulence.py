@@ -39,7 +39,7 @@ from kernels import transport as _t
 
 from .grids import GHOST
 from .launch import ROW0
-from .transport import TransportedScalar, wall_distance
+from .transport import TransportedScalar, advance_pair, wall_distance
 
 __all__ = ["KOmegaSST", "freestream_turbulence"]
 
@@ -114,8 +114,7 @@ class KOmegaSST:
         from the flow's new velocity and the k, omega at the step's start (one coefficient pass per
         step; the flow's next step sees nu_t lagged by that step, as in any segregated scheme)."""
         self.update()
-        self.k.advance(dt)
-        self.omega.advance(dt)
+        advance_pair(self.k, self.omega, dt)
 
     def nu_t(self) -> np.ndarray:
         """(ny, nx) eddy viscosity of the current state."""
