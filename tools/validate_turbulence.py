@@ -2,6 +2,7 @@
 
     python tools/validate_turbulence.py decay                # closed form, first order in dt
     python tools/validate_turbulence.py channel --re-tau 395 # fully developed channel vs the log law
+    python tools/validate_turbulence.py plate --nx 200 --t-end 2  # TMR flat plate (about 25 min)
 
 decay: homogeneous turbulence at rest (no walls: F1 = 0, the outer constants), k0 = 0.01, omega0 = 1,
 to t = 4 with dt = 0.02, 0.01, 0.005. Closed form: omega = omega0 / (1 + beta_2 omega0 t),
@@ -14,6 +15,12 @@ momentum d/dy((nu + nu_t) dU/dy) + 1 = 0 marched implicitly in pseudo-time (a tr
 step; the 2D solver has no periodic sides). Grid: 64 cells across, tanh-clustered (first cell centre
 at y+ = 1), marched to t = 8 h/u_tau (steady: the wall shear balances the driving gradient to 0.1 %).
 Reported: U+ against y+ beside the log law U+ = ln(y+)/0.41 + 5.0 (TMR's constants), U_b+ and U_c+.
+plate: TMR's 2D zero-pressure-gradient flat plate at Re 5e6 per unit length, the plate from x = 0
+(the inflow, at the leading edge) to 2, top at y = 1 (slip), TMR's freestream (k = 2.25e-7 U^2,
+nu_t/nu = 0.009), the first cell ``--dy1`` high (5e-6: y+ ~ 0.5 at x = 0.97) growing by ``--growth``,
+``--nx`` uniform cells along x, the laminar solver with nu + nu_t from the model each step, to
+``--t-end`` (in L/U). Reported: c_f at x = 0.97008 against TMR's 0.00271-0.00272 and the velocity
+profile there in wall units; c_f(x) and the profile as plate_nx<N>.png beside ``--out``.
 Results are appended to ``--out`` as JSON lines.
 """
 
@@ -131,8 +138,8 @@ def plate_faces(dy1: float, growth: float, height: float) -> np.ndarray:
 
 
 def plate(nx=200, dy1=5e-6, growth=1.12, t_end=3.0, reynolds=5e6, threads=2, progress=None):
-    """TMR's 2D zero-pressure-gradient flat plate (module doc of ``main``): returns the model and the
-    skin friction along the plate (x of the u-faces, c_f)."""
+    """TMR's 2D zero-pressure-gradient flat plate (module doc): returns the flow, the model, the skin
+    friction along the plate (x of the u-faces, c_f) and c_f at x = 0.97 every 0.25 L/U."""
     nu = 1.0 / reynolds
     grid = CartesianGrid(np.linspace(0.0, 2.0, nx + 1), plate_faces(dy1, growth, 1.0))
     bc = BoundaryConditions(left="inflow", right="outflow", bottom="noslip", top="slip", u_inf=1.0)
@@ -141,10 +148,15 @@ def plate(nx=200, dy1=5e-6, growth=1.12, t_end=3.0, reynolds=5e6, threads=2, pro
     model = KOmegaSST(sim, k_inf, k_inf / (0.009 * nu))   # TMR: nu_t / nu = 0.009 in the freestream
     sim.set_state(u=1.0)
     model.update()
+    history, next_mark = [], 0.25
     while sim.t < t_end:
         dt = min(sim.stable_dt(), model.stable_dt())
         sim.step(dt)
         model.advance(dt)
+        if sim.t >= next_mark:   # c_f at x = 0.97 every 0.25 L/U: how settled the plate is
+            u1 = sim.u.numpy()[GHOST, GHOST:GHOST + nx + 1]
+            history.append((float(sim.t), float(np.interp(0.97008, grid.x_faces, 2 * nu * u1 / grid.y_centres[0]))))
+            next_mark += 0.25
         if progress and sim.n_steps % 2000 == 0:
             u = sim.u.numpy()[GHOST, GHOST:GHOST + nx + 1]
             if not np.isfinite(u).all():
@@ -152,7 +164,7 @@ def plate(nx=200, dy1=5e-6, growth=1.12, t_end=3.0, reynolds=5e6, threads=2, pro
             progress(sim.t, t_end)
     u1 = sim.u.numpy()[GHOST, GHOST:GHOST + nx + 1]
     cf = 2 * nu * u1 / grid.y_centres[0]
-    return sim, model, grid.x_faces, cf
+    return sim, model, grid.x_faces, cf, history
 
 
 def plate_report(nx, dy1, growth, t_end):
@@ -161,13 +173,46 @@ def plate_report(nx, dy1, growth, t_end):
     def progress(t, t_end):
         print(f"  t = {t:.3f} of {t_end:g}", file=sys.stderr, flush=True)
 
-    sim, model, x, cf = plate(nx, dy1, growth, t_end, progress=progress)
+    sim, model, x, cf, history = plate(nx, dy1, growth, t_end, progress=progress)
     g = sim.grid
     cf97 = float(np.interp(0.97008, x, cf))
     u_tau = np.sqrt(0.5 * cf97)
+    # the velocity profile at the u-face column nearest x = 0.97 in wall units
+    i = int(np.argmin(np.abs(x - 0.97008)))
+    u_col = sim.u.numpy()[GHOST:GHOST + g.ny, GHOST + i]
+    yp, up = g.y_centres * u_tau * 5e6, u_col / u_tau
+    band = (yp >= 30) & (yp <= 300)
+    log = np.log(yp) / KAPPA + B
     return {"case": "SST flat plate (TMR)", "nx": g.nx, "ny": g.ny, "dy1": dy1, "growth": growth, "t_end": t_end,
             "steps": sim.n_steps, "wall_s": time.perf_counter() - t0, "cf_0.97": cf97, "band": [0.00271, 0.00272],
-            "first_cell_y+_0.97": float(g.y_centres[0] * u_tau * 5e6), "x": x.tolist(), "cf": cf.tolist()}
+            "first_cell_y+_0.97": float(yp[0]), "first_cell_U+_0.97": float(up[0]),
+            "cf_0.97_history": history,
+            "log_law_deviation_30_300": float(np.max(np.abs(up[band] / log[band] - 1))) if band.any() else None,
+            "x": x.tolist(), "cf": cf.tolist(), "profile_y+": yp.tolist(), "profile_U+": up.tolist()}
+
+
+def _plot_plate(r, stem: Path) -> None:
+    """c_f(x) and the profile at x = 0.97 in wall units, as a PNG beside the results."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(1, 2, figsize=(10, 4), layout="constrained")
+    ax[0].plot(r["x"], r["cf"], label="SST-2003")
+    ax[0].errorbar([0.97008], [0.002715], yerr=[[0.000005], [0.000005]], fmt="o", color="k",
+                   label="TMR, incompressible codes (0.00271-0.00272)")
+    ax[0].set(xlabel="x", ylabel="c_f", ylim=(0.0015, 0.006), title=f"flat plate, Re 5e6, {r['nx']} x {r['ny']}")
+    ax[0].legend()
+    yp = np.array(r["profile_y+"])
+    ax[1].semilogx(yp, r["profile_U+"], "o-", ms=3, label="SST-2003, x = 0.97")
+    ax[1].semilogx(yp, np.log(yp) / KAPPA + B, "--", label="log law (0.41, 5.0)")
+    ax[1].semilogx(yp[yp < 12], yp[yp < 12], ":", label="U+ = y+")
+    ax[1].set(xlabel="y+", ylabel="U+", xlim=(0.3, 1e4), ylim=(0, 35))
+    ax[1].legend()
+    stem.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(stem.with_suffix(".png"), dpi=110)
+    plt.close(fig)
 
 
 def main(argv=None):
@@ -191,8 +236,10 @@ def main(argv=None):
         r = channel_report(args.re_tau, args.t_end)
     else:
         r = plate_report(args.nx, args.dy1, args.growth, args.t_end)
+        _plot_plate(r, Path(args.out).with_name(f"plate_nx{args.nx}"))
     r["command"] = "python tools/validate_turbulence.py " + " ".join(argv if argv is not None else sys.argv[1:])
-    print(json.dumps({k: v for k, v in r.items() if k not in ("y+", "U+", "x", "cf")}), flush=True)
+    print(json.dumps({k: v for k, v in r.items() if k not in ("y+", "U+", "x", "cf", "profile_y+", "profile_U+")}),
+          flush=True)
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     with open(args.out, "a") as fh:
         fh.write(json.dumps(r) + "\n")
