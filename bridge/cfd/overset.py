@@ -381,6 +381,9 @@ class OversetPair:
         i1 = min(int(np.ceil((X.max() - grid.x_faces[0]) / grid.dx)), grid.nx)
         j0 = max(int(np.searchsorted(grid.y_faces, Y.min())) - 1, 0)
         j1 = min(int(np.searchsorted(grid.y_faces, Y.max())), grid.ny)
+        if i0 < 1 or j0 < 1 or i1 > grid.nx - 1 or j1 > grid.ny - 1:
+            raise ValueError("body grid: it reaches the background's boundary (the hole needs a cell of the "
+                             "background round the body grid)")
         XC, YC = np.meshgrid(grid.x_faces[i0:i1 + 1], grid.y_faces[j0:j1 + 1])
         xi, eta = self.to_body(XC, YC, t_new)
         hx0, hx1, hy0, hy1 = self.hole
