@@ -31,7 +31,8 @@ def test_decaying_turbulence_follows_the_closed_form_at_first_order_in_dt():
 def test_coefficients_in_a_uniform_shear_away_from_walls():
     """u = S y, k and omega uniform, no wall (F1 = F2 = 0): nu_t = k / omega, the k production
     min(nu_t S^2, 10 beta* k omega), the omega production gamma_2 S^2, destruction beta* omega and
-    beta_2 omega, diffusivities nu + sigma nu_t with the outer set."""
+    beta_2 omega, diffusivities nu + sigma nu_t with the outer set; v = S x and plane strain check the
+    other velocity gradients of S^2 = 2 S_ij S_ij."""
     grid = CartesianGrid.uniform(16, 16, (0.0, 1.0), (-0.5, 0.5))
     nu, shear, k, omega = 1e-3, 3.0, 0.02, 5.0
     sim = Simulation(grid, FlowConfig(nu=nu, threads=1, bc=BoundaryConditions(left="slip", right="slip")))
@@ -48,6 +49,22 @@ def test_coefficients_in_a_uniform_shear_away_from_walls():
     np.testing.assert_allclose(model.omega.sink.numpy()[inner], 0.0828 * omega, rtol=1e-12)
     np.testing.assert_allclose(model.k.gamma.numpy()[inner], nu + 1.0 * nut, rtol=1e-12)
     np.testing.assert_allclose(model.omega.gamma.numpy()[inner], nu + 0.856 * nut, rtol=1e-12)
+    # the same shear as v = S x (the other off-diagonal gradient) gives the same coefficients
+    x = grid.x_faces[0] + (np.arange(sim.v.shape[1]) - g + 0.5) * grid.dx
+    sim.u.numpy()[:, :] = 0.0
+    sim.v.numpy()[:, :] = shear * x[None, :]
+    model.update()
+    np.testing.assert_allclose(model.omega.source.numpy()[inner], 0.44 * shear ** 2, rtol=1e-12)
+    np.testing.assert_allclose(model.nu_t(), nut, rtol=1e-12)
+    # plane strain u = S x, v = -S y: S^2 = 2 (S^2 + S^2)
+    xu = grid.x_faces[0] + (np.arange(sim.u.shape[1]) - g) * grid.dx
+    yv = grid.storage_y_faces()
+    sim.u.numpy()[:, :] = shear * xu[None, :]
+    sim.v.numpy()[:, :] = -shear * yv[:, None]
+    model.update()
+    np.testing.assert_allclose(model.omega.source.numpy()[inner], 0.44 * 4 * shear ** 2, rtol=1e-12)
+    sim.u.numpy()[:, :] = shear * y[:, None]
+    sim.v.numpy()[:, :] = 0.0
     # the production limiter: a strong shear caps P at 10 beta* k omega
     sim.u.numpy()[:, :] = 100 * shear * y[:, None]
     model.update()
