@@ -32,12 +32,19 @@ def _xflux(q: wp.array2d(dtype=wp.float64), gam: wp.array2d(dtype=wp.float64), v
 
 
 @wp.func
+def _face_metrics(hy_c: wp.array(dtype=wp.float64), hy_f: wp.array(dtype=wp.float64), J: int):
+    """(rm, rp, w, 1 / d) of the face between rows J - 1 and J: the spacing ratios d / d_below and
+    d / d_above of the limiter, the weight of row J - 1's centre, d the centre-to-centre distance."""
+    d = hy_f[J]
+    return wp.vec4d(d / hy_f[J - 1], d / hy_f[J + 1], wp.float64(0.5) * hy_c[J - 1] / d, wp.float64(1.0) / d)
+
+
+@wp.func
 def _yflux(q: wp.array2d(dtype=wp.float64), gam: wp.array2d(dtype=wp.float64), vel: wp.float64, J: int, I: int,
-           rm: wp.float64, rp: wp.float64, w: wp.float64, ihf: wp.float64, scheme: int):
-    """The same through the face between cells (J - 1, I) and (J, I) (spacing ratios rm, rp, weight w,
-    1 / centre distance ihf)."""
-    return upwind_flux(vel, q[J - 2, I], q[J - 1, I], q[J, I], q[J + 1, I], rm, rp, w, scheme) \
-        - wp.float64(0.5) * (gam[J - 1, I] + gam[J, I]) * (q[J, I] - q[J - 1, I]) * ihf
+           m: wp.vec4d, scheme: int):
+    """The same through the face between cells (J - 1, I) and (J, I) (its ``_face_metrics`` m)."""
+    return upwind_flux(vel, q[J - 2, I], q[J - 1, I], q[J, I], q[J + 1, I], m[0], m[1], m[2], scheme) \
+        - wp.float64(0.5) * (gam[J - 1, I] + gam[J, I]) * (q[J, I] - q[J - 1, I]) * m[3]
 
 
 @wp.func
@@ -62,26 +69,18 @@ def scalar_stage(q: wp.array2d(dtype=wp.float64), u: wp.array2d(dtype=wp.float64
     ``gx_c[J]``: the grid's x-velocity at the height of row J; ``gy_c[I]``: its y-velocity at the x
     of column I (zeros for a fixed grid). The x-flux is carried along the row."""
     J = row0 + wp.tid()
-    half = wp.float64(0.5)
     one = wp.float64(1.0)
     idx = one / dx
     ihc = one / hy_c[J]
     gx = gx_c[J]
-    # y-direction spacings of the faces below (J) and above (J + 1) the row
-    rm_lo = hy_f[J] / hy_f[J - 1]
-    rp_lo = hy_f[J] / hy_f[J + 1]
-    w_lo = half * hy_c[J - 1] / hy_f[J]
-    rm_hi = hy_f[J + 1] / hy_f[J]
-    rp_hi = hy_f[J + 1] / hy_f[J + 2]
-    w_hi = half * hy_c[J] / hy_f[J + 1]
-    ihf_lo = one / hy_f[J]
-    ihf_hi = one / hy_f[J + 1]
+    lo = _face_metrics(hy_c, hy_f, J)        # the faces below and above the row
+    hi = _face_metrics(hy_c, hy_f, J + 1)
     fl = _xflux(q, gam, u[J, i_lo] - gx, J, i_lo, idx, scheme)
     for I in range(i_lo, i_hi):
         gy = gy_c[I]
         fr = _xflux(q, gam, u[J, I + 1] - gx, J, I + 1, idx, scheme)
-        fb = _yflux(q, gam, v[J, I] - gy, J, I, rm_lo, rp_lo, w_lo, ihf_lo, scheme)
-        ft = _yflux(q, gam, v[J + 1, I] - gy, J + 1, I, rm_hi, rp_hi, w_hi, ihf_hi, scheme)
+        fb = _yflux(q, gam, v[J, I] - gy, J, I, lo, scheme)
+        ft = _yflux(q, gam, v[J + 1, I] - gy, J + 1, I, hi, scheme)
         out[J, I] = _stage_value(q, q0, s_e, s_i, J, I, (fr - fl) * idx + (ft - fb) * ihc, dt, a, b)
         fl = fr
 
@@ -101,19 +100,12 @@ def scalar_pair_stage(q1: wp.array2d(dtype=wp.float64), gam1: wp.array2d(dtype=w
     """``scalar_stage`` for two scalars carried by the same velocity in one sweep (k and omega): the
     velocity and the metrics are read once for both."""
     J = row0 + wp.tid()
-    half = wp.float64(0.5)
     one = wp.float64(1.0)
     idx = one / dx
     ihc = one / hy_c[J]
     gx = gx_c[J]
-    rm_lo = hy_f[J] / hy_f[J - 1]
-    rp_lo = hy_f[J] / hy_f[J + 1]
-    w_lo = half * hy_c[J - 1] / hy_f[J]
-    rm_hi = hy_f[J + 1] / hy_f[J]
-    rp_hi = hy_f[J + 1] / hy_f[J + 2]
-    w_hi = half * hy_c[J] / hy_f[J + 1]
-    ihf_lo = one / hy_f[J]
-    ihf_hi = one / hy_f[J + 1]
+    lo = _face_metrics(hy_c, hy_f, J)
+    hi = _face_metrics(hy_c, hy_f, J + 1)
     ul = u[J, i_lo] - gx
     fl1 = _xflux(q1, gam1, ul, J, i_lo, idx, scheme)
     fl2 = _xflux(q2, gam2, ul, J, i_lo, idx, scheme)
@@ -124,10 +116,10 @@ def scalar_pair_stage(q1: wp.array2d(dtype=wp.float64), gam1: wp.array2d(dtype=w
         vt = v[J + 1, I] - gy
         fr1 = _xflux(q1, gam1, ur, J, I + 1, idx, scheme)
         fr2 = _xflux(q2, gam2, ur, J, I + 1, idx, scheme)
-        d1 = (fr1 - fl1) * idx + (_yflux(q1, gam1, vt, J + 1, I, rm_hi, rp_hi, w_hi, ihf_hi, scheme)
-                                  - _yflux(q1, gam1, vb, J, I, rm_lo, rp_lo, w_lo, ihf_lo, scheme)) * ihc
-        d2 = (fr2 - fl2) * idx + (_yflux(q2, gam2, vt, J + 1, I, rm_hi, rp_hi, w_hi, ihf_hi, scheme)
-                                  - _yflux(q2, gam2, vb, J, I, rm_lo, rp_lo, w_lo, ihf_lo, scheme)) * ihc
+        d1 = (fr1 - fl1) * idx + (_yflux(q1, gam1, vt, J + 1, I, hi, scheme)
+                                  - _yflux(q1, gam1, vb, J, I, lo, scheme)) * ihc
+        d2 = (fr2 - fl2) * idx + (_yflux(q2, gam2, vt, J + 1, I, hi, scheme)
+                                  - _yflux(q2, gam2, vb, J, I, lo, scheme)) * ihc
         out1[J, I] = _stage_value(q1, q01, se1, si1, J, I, d1, dt, a, b)
         out2[J, I] = _stage_value(q2, q02, se2, si2, J, I, d2, dt, a, b)
         fl1 = fr1

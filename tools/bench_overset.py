@@ -32,7 +32,8 @@ from bridge.cfd import BoundaryConditions, CartesianGrid, FlowConfig, HarmonicMo
 from bridge.cfd.sections import FlatPlate  # noqa: E402
 
 
-def _shape(text: str) -> tuple[int, int]:
+def grid_shape(text: str) -> tuple[int, int]:
+    """argparse type of a grid size "NXxNY" (at least 16 x 16)."""
     nx, ny = (int(v) for v in text.lower().split("x"))
     if nx < 16 or ny < 16:
         raise argparse.ArgumentTypeError(f"{text}: need at least 16 x 16 cells")
@@ -55,8 +56,8 @@ def build(background: tuple[int, int], body: tuple[int, int]) -> OversetPair:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--background", type=_shape, default=(480, 160))
-    ap.add_argument("--body", type=_shape, default=(160, 120))
+    ap.add_argument("--background", type=grid_shape, default=(480, 160))
+    ap.add_argument("--body", type=grid_shape, default=(160, 120))
     ap.add_argument("--steps", type=int, default=20)
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--json", type=Path, default=None)

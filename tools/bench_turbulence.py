@@ -23,21 +23,15 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import warp as wp  # noqa: E402
+from bench_overset import grid_shape  # noqa: E402  (tools/ is on the path: the script's own folder)
 
 from bridge.cfd import BoundaryConditions, CartesianGrid, FlowConfig, Simulation  # noqa: E402
 from bridge.cfd.turbulence import KOmegaSST, freestream_turbulence  # noqa: E402
 
 
-def _shape(text: str) -> tuple[int, int]:
-    nx, ny = (int(v) for v in text.lower().split("x"))
-    if nx < 16 or ny < 16:
-        raise argparse.ArgumentTypeError(f"{text}: need at least 16 x 16 cells")
-    return nx, ny
-
-
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--size", type=_shape, default=(512, 256))
+    ap.add_argument("--size", type=grid_shape, default=(512, 256))
     ap.add_argument("--steps", type=int, default=20)
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--json", type=Path, default=None)

@@ -148,23 +148,24 @@ def plate(nx=200, dy1=5e-6, growth=1.12, t_end=3.0, reynolds=5e6, threads=2, pro
     model = KOmegaSST(sim, k_inf, k_inf / (0.009 * nu))   # TMR: nu_t / nu = 0.009 in the freestream
     sim.set_state(u=1.0)
     model.update()
+
+    def skin_friction():   # c_f = 2 nu du/dy at the wall along the plate (the u-faces of the first row)
+        return 2 * nu * sim.u.numpy()[GHOST, GHOST:GHOST + nx + 1] / grid.y_centres[0]
+
     history, next_mark = [], 0.25
     while sim.t < t_end:
         dt = min(sim.stable_dt(), model.stable_dt())
         sim.step(dt)
         model.advance(dt)
         if sim.t >= next_mark:   # c_f at x = 0.97 every 0.25 L/U: how settled the plate is
-            u1 = sim.u.numpy()[GHOST, GHOST:GHOST + nx + 1]
-            history.append((float(sim.t), float(np.interp(0.97008, grid.x_faces, 2 * nu * u1 / grid.y_centres[0]))))
+            history.append((float(sim.t), float(np.interp(0.97008, grid.x_faces, skin_friction()))))
             next_mark += 0.25
         if progress and sim.n_steps % 2000 == 0:
             u = sim.u.numpy()[GHOST, GHOST:GHOST + nx + 1]
             if not np.isfinite(u).all():
                 raise FloatingPointError(f"plate: non-finite velocity at t = {sim.t}")
             progress(sim.t, t_end)
-    u1 = sim.u.numpy()[GHOST, GHOST:GHOST + nx + 1]
-    cf = 2 * nu * u1 / grid.y_centres[0]
-    return sim, model, grid.x_faces, cf, history
+    return sim, model, grid.x_faces, skin_friction(), history
 
 
 def plate_report(nx, dy1, growth, t_end):
