@@ -15,6 +15,8 @@ Kernels are typed for float64 (the project's CFD precision, ``bridge.cfd.precisi
 
 import warp as wp
 
+from kernels.wall_law import wall_law_ratio
+
 # Advection schemes (integer codes used inside kernels; names in bridge.cfd.advection).
 SCHEME_CENTRAL = 0
 SCHEME_VANLEER = 1
@@ -459,7 +461,7 @@ def face_gradient(p: wp.array2d(dtype=wp.float64), hy_f: wp.array(dtype=wp.float
 def ib_targets(q: wp.array2d(dtype=wp.float64), phi: wp.array2d(dtype=wp.float64),
                x0: wp.float64, dx: wp.float64, xoff: wp.float64, yc: wp.array(dtype=wp.float64),
                pos: wp.vec3d, vel: wp.vec3d, comp: int, i0: int, j0: int, ni: int,
-               ilo: int, ihi: int, jlo: int, jhi: int, order: int,
+               ilo: int, ihi: int, jlo: int, jhi: int, order: int, wall_law: int, nu: wp.float64,
                target: wp.array2d(dtype=wp.float64), state: wp.array2d(dtype=wp.int32)):
     """Direct-forcing target of each face in the box (state: 0 fluid, 1 solid, 2 interface).
 
@@ -467,7 +469,11 @@ def ib_targets(q: wp.array2d(dtype=wp.float64), phi: wp.array2d(dtype=wp.float64
     grid line take the linear interpolation (Fadlun et al. 2000) between the body velocity at the
     interface point (distance d found from phi along the line) and the next fluid face:
     q_f = q_b + (q_o - q_b) d / (d + h) (``order`` 1), or the quadratic through q_b, q_o and the face
-    after q_o (``order`` 2); estimates from several lines are averaged.
+    after q_o (``order`` 2); estimates from several lines are averaged. ``wall_law`` 1 (with ``order``
+    1): the wall function of a turbulent flow at high Reynolds number - q_f = q_b + (q_o - q_b) r with r
+    = u(phi_f) / u(phi_o) on Spalding's law of the wall through q_o (``kernels.wall_law``; phi: the
+    faces' distances to the wall, u_tau from |q_o - q_b| and the molecular ``nu``); r = phi_f / phi_o,
+    the linear profile, when the reference face lies in the viscous sublayer.
     Only faces with ilo <= I < ihi and jlo <= J < jhi are updated (boundary faces excluded);
     reads ``q`` and writes ``target``/``state`` only, so the result does not depend on order.
     """
@@ -523,7 +529,11 @@ def ib_targets(q: wp.array2d(dtype=wp.float64), phi: wp.array2d(dtype=wp.float64
                             acc += qb * (s1 - d) * (s2 - d) / (s1 * s2) \
                                 + qo * d * (s2 - d) / (s1 * hoo) - qoo * d * (s1 - d) / (s2 * hoo)
                         else:
-                            acc += qb + (qo - qb) * d / (d + ho)
+                            r = d / (d + ho)
+                            po = phi[jb - dj, ib - di]
+                            if wall_law != 0 and po > ph:
+                                r = wall_law_ratio(wp.abs(qo - qb), po, ph, nu)
+                            acc += qb + (qo - qb) * r
                         cnt += wp.float64(1.0)
                 if cnt > wp.float64(0.0):
                     st = 2

@@ -19,6 +19,7 @@ non-negative (the positivity k and omega need). Conservative: the face fluxes te
 import warp as wp
 
 from kernels.cfd import polygon_signed_distance, upwind_flux
+from kernels.wall_law import KAPPA
 
 
 @wp.func
@@ -180,6 +181,75 @@ def cell_wall_distance(verts: wp.array(dtype=wp.vec2d), x0: wp.float64, dx: wp.f
 
 
 
+@wp.func
+def polygon_distance_normal(px: wp.float64, py: wp.float64, verts: wp.array(dtype=wp.vec2d)):
+    """(signed distance, n_x, n_y) of (px, py) to a closed polygon: the distance as
+    ``kernels.cfd.polygon_signed_distance`` (negative inside), n the unit vector from the nearest
+    boundary point to the point (a normal of the nearest segment when the point lies on it)."""
+    n = verts.shape[0]
+    dmin = wp.float64(1.0e300)
+    nx = wp.float64(0.0)
+    ny = wp.float64(1.0)
+    inside = int(0)  # noqa: UP018 (Warp: a dynamic variable, mutated in the loop)
+    for k in range(n):
+        a = verts[k]
+        b = verts[(k + 1) % n]
+        ex = b[0] - a[0]
+        ey = b[1] - a[1]
+        wx = px - a[0]
+        wy = py - a[1]
+        t = wp.clamp((wx * ex + wy * ey) / (ex * ex + ey * ey), wp.float64(0.0), wp.float64(1.0))
+        dx = wx - t * ex
+        dy = wy - t * ey
+        d2 = dx * dx + dy * dy
+        if d2 < dmin:
+            dmin = d2
+            if d2 > wp.float64(1.0e-28):
+                r = wp.sqrt(d2)
+                nx = dx / r
+                ny = dy / r
+            else:
+                r = wp.sqrt(ex * ex + ey * ey)
+                nx = ey / r
+                ny = -ex / r
+        if (a[1] > py) != (b[1] > py):
+            xc = a[0] + (py - a[1]) * ex / ey
+            if px < xc:
+                inside = 1 - inside
+    d = wp.sqrt(dmin)
+    if inside == 1:
+        d = -d
+    return wp.vec3d(d, nx, ny)
+
+
+@wp.kernel
+def body_wall_cells(verts: wp.array(dtype=wp.vec2d), pos: wp.vec3d, x0: wp.float64, dx: wp.float64,
+                    yc: wp.array(dtype=wp.float64), hy_c: wp.array(dtype=wp.float64), g: int, i0: int, j0: int,
+                    ni: int, reset: int, phi: wp.array2d(dtype=wp.float64), ext: wp.array2d(dtype=wp.float64),
+                    dist_sides: wp.array2d(dtype=wp.float64), dist: wp.array2d(dtype=wp.float64)):
+    """The cells of a box around a body moved to pos = (x, y, theta), storage rows j0 + tid, columns i0 ..
+    i0 + ni - 1. ``reset`` 1: dist = dist_sides there (the distance to the box's sides only, before the
+    bodies' minima). ``reset`` 0: phi = the signed distance of the cell centre to the polygon, ext = half
+    the cell's extent along the wall normal, 0.5 (|n_x| dx + |n_y| dy), and dist = min(dist, |phi|)."""
+    jb = wp.tid()
+    J = j0 + jb
+    c = wp.cos(pos[2])
+    s = wp.sin(pos[2])
+    for ib in range(ni):
+        I = i0 + ib
+        if reset != 0:
+            dist[J, I] = dist_sides[J, I]
+        else:
+            X = x0 + (wp.float64(I - g) + wp.float64(0.5)) * dx - pos[0]
+            Y = yc[J] - pos[1]
+            r = polygon_distance_normal(c * X + s * Y, -s * X + c * Y, verts)
+            ngx = c * r[1] - s * r[2]   # the normal in the grid's axes (the body's turned by theta)
+            ngy = s * r[1] + c * r[2]
+            phi[jb, ib] = r[0]
+            ext[jb, ib] = wp.float64(0.5) * (wp.abs(ngx) * dx + wp.abs(ngy) * hy_c[J])
+            dist[J, I] = wp.min(dist[J, I], wp.abs(r[0]))
+
+
 # --- k-omega SST, the 2003 variant (Menter, Kuntz and Langtry 2003; NASA TMR "SST-2003") ----------
 SST_BETA_STAR = wp.constant(wp.float64(0.09))
 SST_A1 = wp.constant(wp.float64(0.31))
@@ -275,3 +345,62 @@ def sst_coefficients(u: wp.array2d(dtype=wp.float64), v: wp.array2d(dtype=wp.flo
     _fill_ghosts(snk_k, J, g, nx, ny)
     _fill_ghosts(src_w, J, g, nx, ny)
     _fill_ghosts(snk_w, J, g, nx, ny)
+
+
+SST_HOLD = wp.constant(wp.float64(1.0e30))   # the rate that holds a cell at a value (source R q, sink R)
+
+
+@wp.kernel
+def sst_body_walls(phi: wp.array2d(dtype=wp.float64), ext: wp.array2d(dtype=wp.float64), i0: int, j0: int,
+                   ni: int, k: wp.array2d(dtype=wp.float64), w: wp.array2d(dtype=wp.float64), nu: wp.float64,
+                   function: int, src_k: wp.array2d(dtype=wp.float64), snk_k: wp.array2d(dtype=wp.float64),
+                   src_w: wp.array2d(dtype=wp.float64), snk_w: wp.array2d(dtype=wp.float64)):
+    """The wall of an immersed body in the SST model (bridge/cfd/turbulence.py), on the box of
+    ``body_wall_cells`` (its phi and ext): the sources of the cells that are held at a value (source
+    R q_w, implicit sink R, R = SST_HOLD, so the stage gives q_w to round-off).
+
+    Cells inside the body (phi <= 0): omega = 60 nu / (beta_1 (2 ext)^2) (Menter's wall value over a
+    cell's extent across the wall); k = 0 for a resolved wall (``function`` 0), or with the wall
+    function the mean k of the cell's fluid neighbours (k has no flux into the wall).
+    With the wall function (``function`` 1), fluid cells whose centre lies within a cell's extent of the
+    wall (phi <= 2 ext): omega = sqrt(omega_vis^2 + omega_log^2), omega_vis = 6 nu / (beta_1 phi^2),
+    omega_log = sqrt(k) / (beta*^(1/4) kappa phi) - the sublayer and log-layer solutions, blended."""
+    jb = wp.tid()
+    J = j0 + jb
+    nj = phi.shape[0]
+    zero = wp.float64(0.0)
+    for ib in range(ni):
+        I = i0 + ib
+        ph = phi[jb, ib]
+        e = ext[jb, ib]
+        if ph <= zero:
+            kt = zero
+            if function != 0:
+                acc = wp.float64(0.0)
+                cnt = wp.float64(0.0)
+                for m in range(4):
+                    di = int(0)  # noqa: UP018 (Warp dynamic variable)
+                    dj = int(0)  # noqa: UP018 (Warp dynamic variable)
+                    if m == 0:
+                        di = -1
+                    elif m == 1:
+                        di = 1
+                    elif m == 2:
+                        dj = -1
+                    else:
+                        dj = 1
+                    if ib + di >= 0 and ib + di < ni and jb + dj >= 0 and jb + dj < nj:
+                        if phi[jb + dj, ib + di] > zero:
+                            acc += wp.max(k[J + dj, I + di], zero)
+                            cnt += wp.float64(1.0)
+                if cnt > zero:
+                    kt = acc / cnt
+            src_k[J, I] = SST_HOLD * kt
+            snk_k[J, I] = SST_HOLD
+            src_w[J, I] = SST_HOLD * wp.float64(15.0) * nu / (SST_BETA1 * e * e)
+            snk_w[J, I] = SST_HOLD
+        elif function != 0 and ph <= wp.float64(2.0) * e:
+            w_vis = wp.float64(6.0) * nu / (SST_BETA1 * ph * ph)
+            w_log = wp.sqrt(wp.max(k[J, I], zero)) / (wp.sqrt(wp.sqrt(SST_BETA_STAR)) * KAPPA * ph)
+            src_w[J, I] = SST_HOLD * wp.sqrt(w_vis * w_vis + w_log * w_log)
+            snk_w[J, I] = SST_HOLD

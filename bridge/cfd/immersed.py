@@ -74,6 +74,7 @@ class ImmersedBody:
         if order not in (1, 2):
             raise ValueError(f"order: interpolation order 1 or 2, got {order}")
         self.order = order
+        self.wall_law = None   # molecular nu of the wall function (set_wall_function); None: no wall function
         self.polygon, self.motion, self.grid, self.L = polygon, motion, grid, launcher
         dev = launcher.device
         self.margin = margin
@@ -97,6 +98,17 @@ class ImmersedBody:
         self.area = polygon.area
         self.inertia = polygon.polar_moment_centroid
         self._centroid_body = polygon.centroid
+
+    def set_wall_function(self, nu: float | None) -> None:
+        """Interface faces take Spalding's law of the wall instead of the linear profile (a turbulent
+        flow at high Reynolds number, ``kernels.cfd.ib_targets``; ``nu``: the molecular viscosity), or
+        the linear profile again (None). Needs ``order`` 1."""
+        if nu is not None:
+            if self.order != 1:
+                raise ValueError(f"the wall function needs interpolation order 1, not {self.order}")
+            if not nu > 0:
+                raise ValueError(f"wall function: nu must be > 0, got {nu}")
+        self.wall_law = None if nu is None else float(nu)
 
     # --- geometry ------------------------------------------------------------------------------
     def _box(self, comp, pose):
@@ -151,7 +163,9 @@ class ImmersedBody:
             ilo, ihi, jlo, jhi = self.limits[comp]
             self.L.once(_k.ib_targets, b["nj"], [q, b["phi"], self.x0, self.dx, self.xoff[comp], yc,
                                                  self.pos, self.vel, comp, b["i0"], b["j0"], b["ni"],
-                                                 ilo, ihi, jlo, jhi, self.order, b["target"], b["state"]])
+                                                 ilo, ihi, jlo, jhi, self.order, int(self.wall_law is not None),
+                                                 0.0 if self.wall_law is None else float(self.wall_law),
+                                                 b["target"], b["state"]])
         self._close_targets()
         for comp, q in ((0, u), (1, v)):
             b = self.boxes[comp]

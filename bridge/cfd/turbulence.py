@@ -57,15 +57,22 @@ def freestream_turbulence(u_inf: float, nu: float, intensity: float = 0.001,
 
 
 class KOmegaSST:
-    """SST-2003 on a ``Simulation``'s grid (module doc). ``polygons`` (with ``pose``): bodies for the
-    wall distance only (their wall treatment is not implemented yet)."""
+    """SST-2003 on a ``Simulation``'s grid (module doc), with the walls of its immersed bodies
+    (``sim.bodies``) treated by ``body_walls``: "function" (Spalding's wall function: for walls whose
+    first fluid point may lie in the log layer, the deck at full scale) or "resolved" (k = 0 at the wall,
+    for grids with the first point in the viscous sublayer)."""
 
-    def __init__(self, sim, k_inf: float, omega_inf: float, polygons=(), pose=(0.0, 0.0, 0.0)):
+    BODY_WALLS = ("function", "resolved")
+
+    def __init__(self, sim, k_inf: float, omega_inf: float, body_walls: str = "function"):
         if not (k_inf >= 0 and omega_inf > 0):
             raise ValueError(f"k_inf >= 0 and omega_inf > 0 needed, got {k_inf}, {omega_inf}")
+        if body_walls not in self.BODY_WALLS:
+            raise ValueError(f"body_walls: one of {', '.join(self.BODY_WALLS)}, got {body_walls!r}")
         self.sim = sim
         grid, bc, nu = sim.grid, sim.config.bc, sim.config.nu
         self.nu = float(nu)
+        self.body_walls = body_walls
         sides_k, sides_w, walls = {}, {}, []
         first = {"bottom": float(grid.dy[0]), "top": float(grid.dy[-1])}
         for side in ("left", "right", "bottom", "top"):
@@ -76,22 +83,81 @@ class KOmegaSST:
                 walls.append(side)
                 sides_k[side] = ("value", 0.0)
                 sides_w[side] = ("value", 60.0 * self.nu / (BETA_1 * first[side] ** 2))
-        d = wall_distance(grid, polygons, pose, walls, device=str(sim.L.device))
+        dev = sim.L.device
+        bodies = list(sim.bodies)
+        d_sides = wall_distance(grid, (), walls=walls, device=str(dev))
+        d = d_sides.copy()
+        for b in bodies:   # the bodies' distances at the starting pose, everywhere
+            d = np.minimum(d, wall_distance(grid, [b.polygon], tuple(float(c) for c in b.motion.pose(sim.t)),
+                                            device=str(dev)))
         self.wall_distance = d
-        d_storage = np.pad(np.minimum(d, 1e100), GHOST, mode="edge")
-        self._dist = wp.array(d_storage, dtype=wp.float64, device=sim.L.device)
-        self._yc = wp.array(grid.storage_y_centres(), dtype=wp.float64, device=sim.L.device)
+        pad = lambda a: np.pad(np.minimum(a, 1e100), GHOST, mode="edge")  # noqa: E731
+        self._dist = wp.array(pad(d), dtype=wp.float64, device=dev)
+        self._dist_sides = wp.array(pad(d_sides), dtype=wp.float64, device=dev)
+        self._yc = wp.array(grid.storage_y_centres(), dtype=wp.float64, device=dev)
+        self._poses = None
+        self._boxes = [{"verts": wp.array(b.polygon.vertices, dtype=wp.vec2d, device=dev), "i0": 0, "j0": 0, "ni": 0,
+                        "nj": 0, "pose": None, "phi": wp.zeros((1, 1), dtype=wp.float64, device=dev),
+                        "ext": wp.zeros((1, 1), dtype=wp.float64, device=dev)} for b in bodies]
+        for b in bodies:
+            b.set_wall_function(self.nu if body_walls == "function" else None)
         self.k = TransportedScalar(sim, "k", sides_k, initial=k_inf)
         self.omega = TransportedScalar(sim, "omega", sides_w, initial=omega_inf)
         self.update()
+
+    def _box(self, body, pose) -> tuple[int, int, int, int]:
+        """(i0, j0, ni, nj) in storage indices: the cells within the body's radius and 4 cells of its
+        reference point at ``pose``."""
+        grid, m = self.sim.grid, 4
+        radius = float(body.polygon.radius)
+        i = np.nonzero(np.abs(grid.x_centres - pose[0]) <= radius + m * grid.dx)[0]
+        j = np.nonzero(np.abs(grid.y_centres - pose[1]) <= radius + m * float(grid.dy.max()))[0]
+        if i.size == 0 or j.size == 0:
+            raise ValueError(f"an immersed body at pose {pose} lies outside the grid")
+        return int(i[0]) + GHOST, int(j[0]) + GHOST, int(i[-1] - i[0] + 1), int(j[-1] - j[0] + 1)
+
+    def _refresh_bodies(self) -> None:
+        """Each body's box at its pose of the flow's time: signed distance, cell extent, and the wall
+        distance (the minimum over the sides and every body; outside the boxes it keeps the starting
+        pose's, off by at most the motion's amplitude far from the body). Nothing is done while no body
+        has moved."""
+        sim, grid, dev = self.sim, self.sim.grid, self.sim.L.device
+        poses = [tuple(float(c) for c in body.motion.pose(sim.t)) for body in sim.bodies]
+        if poses == self._poses:
+            return
+        boxes = [self._box(body, pose) for body, pose in zip(sim.bodies, poses, strict=True)]
+        # every old and new box back to the sides' distance first, then each body's minimum
+        jobs = [(1, box["verts"], old, box) for box, old in zip(self._boxes, self._old_boxes(), strict=True)]
+        for box, pose, new in zip(self._boxes, poses, boxes, strict=True):
+            if box["phi"].shape != (new[3], new[2]):
+                box["phi"] = wp.zeros((new[3], new[2]), dtype=wp.float64, device=dev)
+                box["ext"] = wp.zeros((new[3], new[2]), dtype=wp.float64, device=dev)
+            box.update(i0=new[0], j0=new[1], ni=new[2], nj=new[3], pose=pose)
+            jobs.append((1, box["verts"], new, box))
+        jobs += [(0, box["verts"], (box["i0"], box["j0"], box["ni"], box["nj"]), box) for box in self._boxes]
+        for reset, verts, (i0, j0, ni, nj), box in jobs:
+            if ni == 0:
+                continue
+            sim.L.once(_t.body_wall_cells, nj,
+                       [verts, wp.vec3d(*(box["pose"] or (0.0, 0.0, 0.0))), float(grid.x_faces[0]), grid.dx, self._yc,
+                        sim.hy_c, GHOST, i0, j0, ni, reset, box["phi"], box["ext"], self._dist_sides, self._dist])
+        self._poses = poses
+
+    def _old_boxes(self) -> list:
+        return [(b["i0"], b["j0"], b["ni"], b["nj"]) for b in self._boxes]
 
     def update(self) -> None:
         """The model's coefficients and nu + nu_t from the current velocity, k and omega."""
         sim, g, grid = self.sim, GHOST, self.sim.grid
         k, w = self.k, self.omega
+        self._refresh_bodies()
         sim.L.rows(_t.sst_coefficients, grid.ny, g,
                    [sim.u, sim.v, k.q, w.q, self._dist, self.nu, sim.hy_c, self._yc, grid.dx, g, grid.nx,
                     grid.ny, ROW0, sim.nu, k.gamma, w.gamma, k.source, k.sink, w.source, w.sink])
+        for b in self._boxes:
+            sim.L.once(_t.sst_body_walls, b["nj"], [b["phi"], b["ext"], b["i0"], b["j0"], b["ni"], k.q, w.q, self.nu,
+                                                    int(self.body_walls == "function"), k.source, k.sink,
+                                                    w.source, w.sink])
         nu = sim.nu.numpy()[g:g + grid.ny, g:g + grid.nx]
         sim.nu_rows = nu.max(axis=1)
         sim.nu_max = float(sim.nu_rows.max())

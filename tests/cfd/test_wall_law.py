@@ -1,0 +1,149 @@
+"""Spalding's law of the wall (kernels/wall_law.py): the Warp inversions against the closed form.
+
+Reference: Spalding (1961), J. Appl. Mech. 28: 455-458 - u+ = y+ in the sublayer and the log law
+u+ = ln(y+) / 0.41 + 5.0 above it (the TMR constants).
+"""
+
+import numpy as np
+import warp as wp
+
+from bridge.cfd.grids import GHOST
+from kernels import wall_law as wl
+
+KAPPA, B = 0.41, 5.0
+
+
+def yplus(up):
+    z = KAPPA * up
+    return up + np.exp(-KAPPA * B) * (np.exp(z) - 1 - z - z ** 2 / 2 - z ** 3 / 6)
+
+
+@wp.kernel
+def _invert(yp: wp.array(dtype=wp.float64), re_y: wp.array(dtype=wp.float64),
+            up: wp.array(dtype=wp.float64), up_friction: wp.array(dtype=wp.float64)):
+    i = wp.tid()
+    up[i] = wl.spalding_uplus(yp[i])
+    up_friction[i] = wl.friction_uplus(re_y[i])
+
+
+@wp.kernel
+def _ratio(speed: wp.array(dtype=wp.float64), y_ref: wp.array(dtype=wp.float64), y: wp.array(dtype=wp.float64),
+           nu: wp.float64, out: wp.array(dtype=wp.float64)):
+    i = wp.tid()
+    out[i] = wl.wall_law_ratio(speed[i], y_ref[i], y[i], nu)
+
+
+def _run(kernel, n, inputs, outputs):
+    arrays = [wp.array(np.asarray(a, float), dtype=wp.float64, device="cpu") if isinstance(a, np.ndarray) else a
+              for a in inputs]
+    outs = [wp.zeros(n, dtype=wp.float64, device="cpu") for _ in range(outputs)]
+    wp.launch(kernel, dim=n, inputs=arrays + outs, device="cpu")
+    return [o.numpy() for o in outs]
+
+
+def test_the_inversions_recover_the_closed_form_from_the_sublayer_to_y_plus_1e7():
+    up = np.concatenate([np.linspace(1e-4, 1.0, 7), np.linspace(2, 40, 39)])
+    yp = yplus(up)
+    assert yp.max() > 1e6
+    got, got_friction = _run(_invert, up.size, [yp, up * yp], 2)
+    np.testing.assert_allclose(got, up, rtol=1e-11)
+    np.testing.assert_allclose(got_friction, up, rtol=1e-11)
+
+
+def test_the_limits_are_the_linear_profile_and_the_log_law():
+    yp = np.array([1e-3, 0.1, 1e3, 1e4, 1e5])
+    got, _ = _run(_invert, yp.size, [yp, yp], 2)
+    np.testing.assert_allclose(got[:2], yp[:2], rtol=1e-3)
+    np.testing.assert_allclose(got[2:], np.log(yp[2:]) / KAPPA + B, atol=0.05)
+
+
+def test_the_ratio_follows_the_profile_and_is_linear_in_the_sublayer():
+    nu, u_tau = 1e-5, 0.05
+    y_ref = np.array([2e-3, 1e-2, 5e-5, 1e-4])      # y+ 10, 50, 0.25, 0.5
+    y = 0.3 * y_ref
+    up_ref = np.interp(y_ref * u_tau / nu, yplus(np.linspace(0, 40, 400001)), np.linspace(0, 40, 400001))
+    up_y = np.interp(y * u_tau / nu, yplus(np.linspace(0, 40, 400001)), np.linspace(0, 40, 400001))
+    (got,) = _run(_ratio, 4, [u_tau * up_ref, y_ref, y, nu], 1)
+    np.testing.assert_allclose(got, up_y / up_ref, rtol=1e-6)
+    np.testing.assert_allclose(got[2:], 0.3, rtol=2e-3)   # the sublayer: linear
+    assert got[1] > 0.5                                   # the log layer: far fuller than linear
+
+
+# --- the immersed boundary's wall function and the SST model's wall cells ---------------------------
+
+def _slab_flow(u_tau=0.05, nu=1e-5, wall_y=0.0213):
+    """A horizontal slab (top at ``wall_y``) in a grid with cells 4e-3 high (y+ 20 per cell), u set to
+    Spalding's profile above it; returns the simulation, its body and the profile."""
+    from bridge.cfd import CartesianGrid, FlowConfig, Polygon, Simulation, Stationary
+
+    grid = CartesianGrid(np.linspace(0.0, 0.4, 41), np.linspace(0.0, 0.2, 51))
+    sim = Simulation(grid, FlowConfig(nu=nu, threads=1))
+    body = sim.add_body(Polygon(np.array([[0.1, -0.05], [0.3, -0.05], [0.3, wall_y], [0.1, wall_y]])), Stationary())
+    ups = np.linspace(0.0, 40.0, 400001)
+
+    def profile(y):
+        return u_tau * np.interp(np.maximum(y - wall_y, 0.0) * u_tau / nu, yplus(ups), ups)
+
+    sim.u.numpy()[:, :] = profile(grid.storage_y_centres())[:, None]
+    return sim, body, profile
+
+
+def _forced_u(sim, body, wall_function):
+    body.set_wall_function(sim.config.nu if wall_function else None)
+    body.update(0.0)
+    before = sim.u.numpy().copy()
+    body.apply(sim.u, sim.v, 0)
+    box = body.boxes[0]
+    st = box["state"].numpy()
+    j, i = np.nonzero(st == 2)
+    J, I = j + box["j0"], i + box["i0"]
+    return J, I, before, sim.u.numpy()
+
+
+def test_the_wall_function_reconstructs_a_law_of_the_wall_profile_exactly():
+    """Faces next to a flat immersed wall, given Spalding's profile above them, get the profile's value
+    back (to the root-finder's round-off), where the linear profile of the laminar forcing is far off:
+    the forced face at y+ ~ 5-25 lies between the sublayer and the log layer."""
+    sim, body, profile = _slab_flow()
+    J, I, before, after = _forced_u(sim, body, wall_function=True)
+    top = J[(I > GHOST_COLS[0]) & (I < GHOST_COLS[1])]   # the faces above the top, away from the ends
+    cols = I[(I > GHOST_COLS[0]) & (I < GHOST_COLS[1])]
+    assert top.size > 5
+    np.testing.assert_allclose(after[top, cols], before[top, cols], rtol=1e-9)
+    sim2, body2, _ = _slab_flow()
+    J2, I2, before2, after2 = _forced_u(sim2, body2, wall_function=False)
+    assert np.max(np.abs(after2[top, cols] / before2[top, cols] - 1)) > 0.1
+
+
+GHOST_COLS = (GHOST + 13, GHOST + 27)   # storage columns of u-faces at x = 0.13-0.27, inside the slab (0.1-0.3)
+
+
+def test_the_sst_wall_cells_hold_omega_at_the_blended_wall_value_and_k_free_of_wall_flux():
+    """After one step of the model on the slab: fluid cells within a cell of the wall hold omega =
+    sqrt(omega_vis^2 + omega_log^2) of their k and distance; cells inside hold the mean k of their fluid
+    neighbours (no flux of k into the wall) with the wall function, k = 0 for a resolved wall."""
+    from bridge.cfd.turbulence import KOmegaSST
+
+    sim, body, _ = _slab_flow()
+    nu = sim.config.nu
+    model = KOmegaSST(sim, 1e-3, 10.0, body_walls="function")
+    model.advance(1e-4)   # a first step to give k some variation near the wall
+    k0 = model.k.interior().copy()
+    model.advance(1e-4)
+    g, grid = GHOST, sim.grid
+    yc = grid.y_centres
+    k, w = model.k.interior(), model.omega.interior()
+    d_row = yc - 0.0213
+    cols = slice(12, 28)   # cells with centres inside the slab's x range, away from its ends
+    first = int(np.nonzero(d_row > 0)[0][0])          # the first fluid row; its centre is within one cell (4e-3)
+    assert 0 < d_row[first] <= 4e-3 < d_row[first + 1]
+    kk, d = k0[first, cols], d_row[first]   # the hold uses the step's starting k
+    expect = np.sqrt((6 * nu / (0.075 * d * d)) ** 2 + (np.sqrt(kk) / (0.09 ** 0.25 * 0.41 * d)) ** 2)
+    np.testing.assert_allclose(w[first, cols], expect, rtol=1e-6)
+    np.testing.assert_allclose(k[first - 1, cols], k0[first, cols], rtol=1e-12)   # the solid row under it
+    assert np.all(np.isfinite(sim.nu.numpy()[g:g + grid.ny, g:g + grid.nx]))
+    sim2, _, _ = _slab_flow()
+    model2 = KOmegaSST(sim2, 1e-3, 10.0, body_walls="resolved")
+    model2.advance(1e-4)
+    assert np.all(np.abs(model2.k.interior()[first - 1, cols]) < 1e-20)   # held at 0 (to 1e-30 per unit dt)
+    assert sim2.bodies[0].wall_law is None and sim.bodies[0].wall_law == nu
