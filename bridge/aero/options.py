@@ -17,6 +17,13 @@ Keys (all optional):
     grid                  "single": one grid, the section an immersed body moving on it (default); "overset":
                           the section in a fine grid that moves with it over a coarser fixed background
                           (bridge/cfd/overset.py; no face of the body changes class as it moves)
+    turbulence            "laminar": the preset's low Reynolds number, no turbulence model (default); "sst": the
+                          k-omega SST model (2003 variant) with Spalding's wall function on the section, at the
+                          deck's Reynolds number Re = wind_speed_m_s B / nu_air ([air] kinematic viscosity);
+                          single grid only (bridge/cfd/turbulence.py, docs/cfd.md)
+    wind_speed_m_s        the wind speed that sets the Reynolds number with turbulence = "sst" (default the
+                          thesis's 50 m/s: Re = 1.05e8 for the Great Belt's 31 m); the derivatives are
+                          per unit wind speed either way
     static_angles_deg     angles of attack (degrees, nose-up) at which the section is held still for its
                           static coefficients C_D, C_L, C_M, their slopes and the Strouhal number
                           (default -2, 0, 2; [] skips them); with aerodynamics = "cfd" they supply the
@@ -46,9 +53,18 @@ class AeroOptions:
     static_angles_deg: tuple[float, ...] = (-2.0, 0.0, 2.0)
     excitation: str = "single"
     grid: str = "single"
+    turbulence: str = "laminar"
+    wind_speed_m_s: float = 50.0
 
     def __post_init__(self):
-        from bridge.aero.forced_motion import GRIDS, QUALITY
+        from bridge.aero.forced_motion import GRIDS, QUALITY, TURBULENCE
+
+        if self.turbulence not in TURBULENCE:
+            raise InputError("aero.turbulence", self.turbulence, f"one of {', '.join(TURBULENCE)}")
+        if self.turbulence != "laminar" and self.grid != "single":
+            raise InputError("aero.turbulence", self.turbulence, 'laminar with grid = "overset" (the SST model runs '
+                             "on the single grid only, for now)")
+        check_range("aero.wind_speed_m_s", self.wind_speed_m_s, 0.0, 200.0, low_open=True)
 
         if self.grid not in GRIDS:
             raise InputError("aero.grid", self.grid, f"one of {', '.join(GRIDS)}")

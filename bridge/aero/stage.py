@@ -19,7 +19,7 @@ cached like every stage's and shared by bridges with the same deck (``Stage.shar
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -64,6 +64,7 @@ class AeroResult:
     static_records: tuple[dict, ...] = ()   # per static case: angle_deg, steps, wall_s, t, lift, drag, moment
     grid: str = "single"               # [aero] grid: "single" or "overset"
     grids: str = ""                    # the grids in words, e.g. "480 x 144 cells"
+    turbulence: str = "laminar"        # [aero] turbulence: "laminar" or "sst"
 
     @property
     def reduced_velocity(self) -> np.ndarray:
@@ -93,6 +94,10 @@ def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
     aopts: AeroOptions = getattr(scenario, "aero", None) or AeroOptions()
     quality = options.quality or ("tiny" if options.quick else aopts.quality)
     q = preset(quality, aopts.grid)
+    if aopts.turbulence != "laminar":   # the deck's own Reynolds number, with the SST model
+        air = getattr(scenario, "air", None)
+        nu_air = air.kinematic_viscosity_m2_s if air is not None else 1.48e-5
+        q = replace(q, turbulence=aopts.turbulence, reynolds=aopts.wind_speed_m_s * section.chord_m / nu_air)
     poly = _unit_polygons(section)
     cells_across = (section.depth_m / section.chord_m) * q.cells_per_chord / q.dy_over_dx
     warning = ("" if cells_across >= 2.0 else
@@ -103,7 +108,7 @@ def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
     Ks = np.array(sorted(2 * np.pi / np.asarray(aopts.reduced_velocities)))
     runs = options.cache / "aero-runs" if options.cache is not None else None
     options.say(f"aero: {section.describe()}; {len(Ks)} reduced frequencies x heave and pitch on the "
-                f"{quality!r} preset ({aopts.grid} grid, Re = {q.reynolds:g}, laminar)")
+                f"{quality!r} preset ({aopts.grid} grid, Re = {q.reynolds:.3g}, {_flow_model(q)})")
     values = {n: np.zeros(len(Ks), dtype=complex) for n in VERTICAL_TORSIONAL + ("h_qu", "h_qtheta")}
     errors = {n: np.zeros(len(Ks), dtype=complex) for n in values}
     records, cells, grids = [], 0, ""
@@ -143,12 +148,16 @@ def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
     measured = VERTICAL_TORSIONAL + (("h_qu", "h_qtheta") if aopts.excitation == "single" else ())
     table = DerivativeTable(Ks, derivatives_from_frf(Ks, frf), source=f"cfd ({section.name}, {quality})",
                             provides=measured)
-    table.name = f"cfd ({section.name}, {quality}, Re {q.reynolds:g})"
+    table.name = f"cfd ({section.name}, {quality}, Re {q.reynolds:.3g}{', SST' if q.turbulence == 'sst' else ''})"
     model = table if static is None else WithLateral(table, static.quasi_steady())
     data = AeroResult(section.describe(), quality, q.reynolds, cells, Ks, frf, stderr, model, tuple(records),
-                      warning, static, tuple(static_records), aopts.grid, grids)
+                      warning, static, tuple(static_records), aopts.grid, grids, q.turbulence)
     return StageOutput(summary=_summary(data), write_h5=lambda g: _write_h5(g, data), report=_report(data),
                        figures=_figures(data), data=data)
+
+
+def _flow_model(q) -> str:
+    return "laminar" if q.turbulence == "laminar" else "k-omega SST-2003 with Spalding's wall function"
 
 
 def _forced_cases(Ks: np.ndarray, aopts: AeroOptions) -> list[ForcedCase]:
@@ -185,6 +194,7 @@ def _static_runs(poly, section, aopts: AeroOptions, q, runs, options: RunOptions
 
 def _summary(d: AeroResult) -> dict[str, Any]:
     s: dict[str, Any] = {"aero.section": d.section, "aero.quality": d.quality, "aero.reynolds": d.reynolds,
+                         "aero.turbulence": d.turbulence,
                          "aero.cases": len(d.records), "aero.grid_cells": d.cells, "aero.grid": d.grid,
                          "aero.reduced_velocity_min": float(d.reduced_velocity.min()),
                          "aero.reduced_velocity_max": float(d.reduced_velocity.max()),
@@ -207,6 +217,7 @@ def _write_h5(group: Any, d: AeroResult) -> None:
     group.attrs["quality"] = d.quality
     group.attrs["grid"] = d.grid
     group.attrs["reynolds"] = d.reynolds
+    group.attrs["turbulence"] = d.turbulence
     write_dataset(group, "reduced_frequency", d.reduced_frequency, "1", f"({n},) K = Omega = w B / V of the runs")
     write_dataset(group, "reduced_velocity", d.reduced_velocity, "1", f"({n},) U / (f B) = 2 pi / K")
     for name in values_of(d):
@@ -259,10 +270,12 @@ def _report(d: AeroResult) -> str:
     theo = derivatives_from_frf(d.reduced_frequency, Theodorsen().frf(d.reduced_frequency, 1.0))
     der = d.derivatives
     lines = ["## Aerodynamics of the deck section from forced-motion CFD (thesis 5.2-5.3)", "",
-             f"{d.section}; preset {d.quality!r}, {d.grid} grid ({d.grids}), laminar at Re = {d.reynolds:g} "
-             "(the deck's Re of about 1e8 needs the turbulence model of a later stage: these are low-Reynolds "
-             "numbers).  Heave and pitch with the thesis's velocity amplitudes, transient periods dropped, a "
-             "least-squares harmonic fit over the whole periods left (docs/aero.md).", ""]
+             f"{d.section}; preset {d.quality!r}, {d.grid} grid ({d.grids}), " + (
+                 f"laminar at Re = {d.reynolds:g} (a low Reynolds number: the deck's, about 1e8, needs "
+                 "[aero] turbulence = \"sst\")" if d.turbulence == "laminar" else
+                 f"URANS with the k-omega SST model (2003 variant) and Spalding's wall function at Re = "
+                 f"{d.reynolds:.3g}") + ".  Heave and pitch with the thesis's velocity amplitudes, transient "
+             "periods dropped, a least-squares harmonic fit over the whole periods left (docs/aero.md).", ""]
     if d.warning:
         lines += [f"**Warning: {d.warning}.**", ""]
     lines += ["| U/(fB) | H1* | H1* Theodorsen | H3* | H3* Theodorsen | A1* | A1* Theodorsen | A2* "

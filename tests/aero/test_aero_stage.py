@@ -15,13 +15,19 @@ class Killed(Exception):
     pass
 
 
-@pytest.mark.parametrize("grid", ["single", pytest.param("overset", marks=pytest.mark.slow)])  # overset ~20 s
+@pytest.mark.parametrize("grid", ["single", pytest.param("overset", marks=pytest.mark.slow),
+                                  pytest.param("single-sst", marks=pytest.mark.slow)])
 def test_a_killed_case_resumes_from_its_checkpoint_and_ends_with_the_same_numbers(tmp_path, grid):
     """Bit for bit: the checkpoint holds all the state (overset: both grids and the body grid's stream
-    function of the last two steps, which the hole extrapolates)."""
+    function of the last two steps, which the hole extrapolates; SST: k, omega and the eddy viscosity
+    of the next step). Overset and SST ~20 s each (slow), the laminar single grid a few seconds."""
+    from dataclasses import replace
+
     poly = _unit_polygon(Rectangle(10.0, 2.0))
     case = ForcedCase("heave", (2.5,), (0.005,))
-    q = preset("tiny", grid)
+    q = preset("tiny", grid.removesuffix("-sst"))
+    if grid.endswith("-sst"):
+        q = replace(q, turbulence="sst", reynolds=1e7)
     whole = run_case(poly, case, q)
     ckpt = tmp_path / "case.h5"
     calls = []
