@@ -18,8 +18,8 @@ non-negative (the positivity k and omega need). Conservative: the face fluxes te
 
 import warp as wp
 
-from kernels.cfd import polygon_signed_distance, upwind_flux
-from kernels.wall_law import KAPPA
+from kernels.cfd import polygon_signed_distance, rigid_velocity, upwind_flux
+from kernels.wall_law import KAPPA, friction_uplus
 
 
 @wp.func
@@ -348,13 +348,17 @@ def sst_coefficients(u: wp.array2d(dtype=wp.float64), v: wp.array2d(dtype=wp.flo
 
 
 SST_HOLD = wp.constant(wp.float64(1.0e30))   # the rate that holds a cell at a value (source R q, sink R)
+SST_YPLUS_LOG = wp.constant(wp.float64(10.8))   # y+ where the log law (0.41, 5.0) meets u+ = y+
 
 
 @wp.kernel
 def sst_body_walls(phi: wp.array2d(dtype=wp.float64), ext: wp.array2d(dtype=wp.float64), i0: int, j0: int,
-                   ni: int, k: wp.array2d(dtype=wp.float64), w: wp.array2d(dtype=wp.float64), nu: wp.float64,
-                   function: int, src_k: wp.array2d(dtype=wp.float64), snk_k: wp.array2d(dtype=wp.float64),
-                   src_w: wp.array2d(dtype=wp.float64), snk_w: wp.array2d(dtype=wp.float64)):
+                   ni: int, k: wp.array2d(dtype=wp.float64), w: wp.array2d(dtype=wp.float64),
+                   u: wp.array2d(dtype=wp.float64), v: wp.array2d(dtype=wp.float64), x0: wp.float64,
+                   dx: wp.float64, yc: wp.array(dtype=wp.float64), g: int, pos: wp.vec3d, vel: wp.vec3d,
+                   nu: wp.float64, function: int, src_k: wp.array2d(dtype=wp.float64),
+                   snk_k: wp.array2d(dtype=wp.float64), src_w: wp.array2d(dtype=wp.float64),
+                   snk_w: wp.array2d(dtype=wp.float64)):
     """The wall of an immersed body in the SST model (bridge/cfd/turbulence.py), on the box of
     ``body_wall_cells`` (its phi and ext): the sources of the cells that are held at a value (source
     R q_w, implicit sink R, R = SST_HOLD, so the stage gives q_w to round-off).
@@ -364,7 +368,12 @@ def sst_body_walls(phi: wp.array2d(dtype=wp.float64), ext: wp.array2d(dtype=wp.f
     function the mean k of the cell's fluid neighbours (k has no flux into the wall).
     With the wall function (``function`` 1), fluid cells whose centre lies within a cell's extent of the
     wall (phi <= 2 ext): omega = sqrt(omega_vis^2 + omega_log^2), omega_vis = 6 nu / (beta_1 phi^2),
-    omega_log = sqrt(k) / (beta*^(1/4) kappa phi) - the sublayer and log-layer solutions, blended."""
+    omega_log = sqrt(k) / (beta*^(1/4) kappa phi) - the sublayer and log-layer solutions, blended - and
+    the k production of the log layer, P = tau_w du/dn = u_tau^2 beta*^(1/4) sqrt(k) / (kappa phi), with
+    u_tau from the cell's speed relative to the body (pos, vel: the body's pose and velocity) on
+    Spalding's law, where the cell lies in the log layer (y+ > 10.8, where ln(y+)/0.41 + 5 meets y+; below,
+    the model's own production): the strain rate of the cell itself spans the wall and would overstate
+    it. The production keeps the model's limiter, 10 beta* k omega."""
     jb = wp.tid()
     J = j0 + jb
     nj = phi.shape[0]
@@ -400,7 +409,18 @@ def sst_body_walls(phi: wp.array2d(dtype=wp.float64), ext: wp.array2d(dtype=wp.f
             src_w[J, I] = SST_HOLD * wp.float64(15.0) * nu / (SST_BETA1 * e * e)
             snk_w[J, I] = SST_HOLD
         elif function != 0 and ph <= wp.float64(2.0) * e:
+            sk = wp.sqrt(wp.max(k[J, I], zero))
             w_vis = wp.float64(6.0) * nu / (SST_BETA1 * ph * ph)
-            w_log = wp.sqrt(wp.max(k[J, I], zero)) / (wp.sqrt(wp.sqrt(SST_BETA_STAR)) * KAPPA * ph)
+            w_log = sk / (wp.sqrt(wp.sqrt(SST_BETA_STAR)) * KAPPA * ph)
             src_w[J, I] = SST_HOLD * wp.sqrt(w_vis * w_vis + w_log * w_log)
             snk_w[J, I] = SST_HOLD
+            xc = x0 + (wp.float64(I - g) + wp.float64(0.5)) * dx
+            ur = wp.float64(0.5) * (u[J, I] + u[J, I + 1]) - rigid_velocity(xc, yc[J], pos, vel, 0)
+            vr = wp.float64(0.5) * (v[J, I] + v[J + 1, I]) - rigid_velocity(xc, yc[J], pos, vel, 1)
+            speed = wp.sqrt(ur * ur + vr * vr)
+            up = friction_uplus(speed * ph / nu)
+            if up > zero:
+                u_tau = speed / up
+                if ph * u_tau > SST_YPLUS_LOG * nu:   # in the log layer; below it the model's own production
+                    src_k[J, I] = wp.min(u_tau * u_tau * wp.sqrt(wp.sqrt(SST_BETA_STAR)) * sk / (KAPPA * ph),
+                                         wp.float64(10.0) * SST_BETA_STAR * sk * sk * w_log)

@@ -3,6 +3,7 @@
     python tools/validate_turbulence.py decay                # closed form, first order in dt
     python tools/validate_turbulence.py channel --re-tau 395 # fully developed channel vs the log law
     python tools/validate_turbulence.py plate --nx 200 --t-end 2  # TMR flat plate (about 25 min)
+    python tools/validate_turbulence.py ibplate --dy 4e-4 --t-end 2.5  # the same plate immersed, wall function
 
 decay: homogeneous turbulence at rest (no walls: F1 = 0, the outer constants), k0 = 0.01, omega0 = 1,
 to t = 4 with dt = 0.02, 0.01, 0.005. Closed form: omega = omega0 / (1 + beta_2 omega0 t),
@@ -21,6 +22,13 @@ nu_t/nu = 0.009), the first cell ``--dy1`` high (5e-6: y+ ~ 0.5 at x = 0.97) gro
 ``--nx`` uniform cells along x, the laminar solver with nu + nu_t from the model each step, to
 ``--t-end`` (in L/U). Reported: c_f at x = 0.97008 against TMR's 0.00271-0.00272 and the velocity
 profile there in wall units; c_f(x) and the profile as plate_nx<N>.png beside ``--out``.
+ibplate: the same plate (Re 5e6 per unit length, TMR's freestream) as an immersed body with
+Spalding's wall function (bridge/cfd/turbulence.py): a plate from x = 0 to 2, ``6 dy`` thick with
+wedge ends 0.05 long, in a stream from x = -0.5 to 2.5 between slip walls at y = +-1, cells 0.01 long
+and ``--dy`` high at the plate (stretching by 1.1 beyond 4 cells of it), both sides turbulent. c_f(x)
+on the upper side comes from the wall law through the velocity of the first u-face row more than 1.5
+dy above the wall (as the wall function sees it); reported: c_f at x = 0.97 against TMR's resolved
+0.00271-0.00272, its y+, and the drag force beside the friction integrated from c_f(x) on both sides.
 Results are appended to ``--out`` as JSON lines.
 """
 
@@ -168,6 +176,68 @@ def plate(nx=200, dy1=5e-6, growth=1.12, t_end=3.0, reynolds=5e6, threads=2, pro
     return sim, model, grid.x_faces, skin_friction(), history
 
 
+def spalding_uplus_from_re(re_y: np.ndarray) -> np.ndarray:
+    """u+ = U / u_tau of points moving at U at distance y from a wall, from re_y = U y / nu, on Spalding's
+    law (kernels/wall_law.py has the formula; here a dense table, independent of the kernels)."""
+    up = np.linspace(1e-6, 60.0, 600_001)
+    z = KAPPA * up
+    yp = up + np.exp(-KAPPA * B) * (np.exp(z) - 1 - z - z * z / 2 - z ** 3 / 6)
+    return np.interp(re_y, up * yp, up)
+
+
+def ibplate(dy=4e-4, dx=0.01, t_end=2.5, reynolds=5e6, threads=2, progress=None):
+    """The flat plate as an immersed body with the wall function (module doc): returns a report dict."""
+    from bridge.cfd import Polygon, Stationary, stretched_faces
+
+    t0 = time.perf_counter()
+    nu = 1.0 / reynolds
+    half = 3 * dy                                   # the plate is 6 dy thick
+    x = np.arange(-0.5, 2.5 + 0.5 * dx, dx)
+    grid = CartesianGrid(x, stretched_faces(-1.0, 1.0, (-half - 4 * dy, half + 4 * dy), dy, 1.1))
+    bc = BoundaryConditions(left="inflow", right="outflow", bottom="slip", top="slip", u_inf=1.0)
+    sim = Simulation(grid, FlowConfig(nu=nu, cfl=0.5, fourier=0.2, threads=threads, bc=bc))
+    w = 0.05
+    sim.add_body(Polygon(np.array([[0, 0], [w, -half], [2 - w, -half], [2, 0], [2 - w, half], [w, half]])),
+                 Stationary())
+    k_inf = 9e-9 / 0.2 ** 2
+    model = KOmegaSST(sim, k_inf, k_inf / (0.009 * nu), body_walls="function")
+    sim.set_state(u=1.0)
+    model.update()
+    yc = grid.y_centres
+    row = int(np.nonzero(yc > half + 1.5 * dy)[0][0])
+    d_ref = yc[row] - half
+    xu = grid.x_faces
+    on = (xu > w) & (xu < 2 - w)
+
+    def skin_friction():
+        u = sim.u.numpy()[GHOST + row, GHOST:GHOST + grid.nx + 1]
+        up = spalding_uplus_from_re(np.maximum(u, 0.0) * d_ref / nu)
+        u_tau = np.where(up > 0, np.maximum(u, 0.0) / np.maximum(up, 1e-30), 0.0)
+        return 2 * u_tau ** 2, d_ref * u_tau / nu
+
+    history, next_mark = [], 0.25
+    while sim.t < t_end:
+        dt = min(sim.stable_dt(), model.stable_dt())
+        sim.step(dt)
+        model.advance(dt)
+        if sim.t >= next_mark:
+            cf, _ = skin_friction()
+            history.append((float(sim.t), float(np.interp(0.97008, xu, cf)), float(sim.last_force[0][0])))
+            next_mark += 0.25
+            if not np.isfinite(cf).all():
+                raise FloatingPointError(f"ibplate: non-finite velocity at t = {sim.t}")
+            if progress:
+                progress(sim.t, t_end)
+    cf, yp = skin_friction()
+    friction = 2 * np.trapezoid(np.where(on, cf, 0.0), xu) * 0.5   # both sides, rho U^2 / 2 = 1/2
+    return {"case": "SST flat plate, immersed, wall function", "dy": dy, "dx": dx, "nx": grid.nx, "ny": grid.ny,
+            "t_end": t_end, "steps": sim.n_steps, "wall_s": time.perf_counter() - t0,
+            "cf_0.97": float(np.interp(0.97008, xu, cf)), "band": [0.00271, 0.00272],
+            "y+_0.97": float(np.interp(0.97008, xu, yp)), "reference_height": float(d_ref),
+            "drag_force": float(sim.last_force[0][0]), "friction_from_cf": float(friction),
+            "cf_0.97_history": history, "x": xu[on].tolist(), "cf": cf[on].tolist()}
+
+
 def plate_report(nx, dy1, growth, t_end):
     t0 = time.perf_counter()
 
@@ -218,7 +288,8 @@ def _plot_plate(r, stem: Path) -> None:
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("case", choices=["decay", "channel", "plate"])
+    ap.add_argument("case", choices=["decay", "channel", "plate", "ibplate"])
+    ap.add_argument("--dy", type=float, default=4e-4, help="ibplate: cell height at the plate (4e-4: y+ ~ 100)")
     ap.add_argument("--nx", type=int, default=200, help="plate: cells along x in [0, 2]")
     ap.add_argument("--dy1", type=float, default=5e-6, help="plate: first cell height (Re 5e6: y+ ~ 1 is 5e-6)")
     ap.add_argument("--growth", type=float, default=1.12, help="plate: cell growth away from the wall")
@@ -235,6 +306,11 @@ def main(argv=None):
         r = decay()
     elif args.case == "channel":
         r = channel_report(args.re_tau, args.t_end)
+    elif args.case == "ibplate":
+        if not 5e-5 <= args.dy <= 5e-3:
+            ap.error(f"--dy: {args.dy} not allowed; allowed: 5e-5 .. 5e-3")
+        r = ibplate(args.dy, t_end=args.t_end,
+                    progress=lambda t, t_end: print(f"  t = {t:.2f} of {t_end:g}", file=sys.stderr, flush=True))
     else:
         r = plate_report(args.nx, args.dy1, args.growth, args.t_end)
         _plot_plate(r, Path(args.out).with_name(f"plate_nx{args.nx}"))

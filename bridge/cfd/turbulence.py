@@ -154,10 +154,12 @@ class KOmegaSST:
         sim.L.rows(_t.sst_coefficients, grid.ny, g,
                    [sim.u, sim.v, k.q, w.q, self._dist, self.nu, sim.hy_c, self._yc, grid.dx, g, grid.nx,
                     grid.ny, ROW0, sim.nu, k.gamma, w.gamma, k.source, k.sink, w.source, w.sink])
-        for b in self._boxes:
-            sim.L.once(_t.sst_body_walls, b["nj"], [b["phi"], b["ext"], b["i0"], b["j0"], b["ni"], k.q, w.q, self.nu,
-                                                    int(self.body_walls == "function"), k.source, k.sink,
-                                                    w.source, w.sink])
+        for b, body in zip(self._boxes, sim.bodies, strict=True):
+            vel = wp.vec3d(*(float(c) for c in body.motion.velocity(sim.t)))
+            sim.L.once(_t.sst_body_walls, b["nj"],
+                       [b["phi"], b["ext"], b["i0"], b["j0"], b["ni"], k.q, w.q, sim.u, sim.v, float(grid.x_faces[0]),
+                        grid.dx, self._yc, g, wp.vec3d(*b["pose"]), vel, self.nu, int(self.body_walls == "function"),
+                        k.source, k.sink, w.source, w.sink])
         nu = sim.nu.numpy()[g:g + grid.ny, g:g + grid.nx]
         sim.nu_rows = nu.max(axis=1)
         sim.nu_max = float(sim.nu_rows.max())

@@ -120,11 +120,13 @@ GHOST_COLS = (GHOST + 13, GHOST + 27)   # storage columns of u-faces at x = 0.13
 
 def test_the_sst_wall_cells_hold_omega_at_the_blended_wall_value_and_k_free_of_wall_flux():
     """After one step of the model on the slab: fluid cells within a cell of the wall hold omega =
-    sqrt(omega_vis^2 + omega_log^2) of their k and distance; cells inside hold the mean k of their fluid
-    neighbours (no flux of k into the wall) with the wall function, k = 0 for a resolved wall."""
+    sqrt(omega_vis^2 + omega_log^2) of their k and distance, and produce k at the log layer's rate
+    u_tau^2 beta*^(1/4) sqrt(k) / (kappa d) with u_tau of the profile; cells inside hold the mean k of
+    their fluid neighbours (no flux of k into the wall) with the wall function, k = 0 for a resolved
+    wall."""
     from bridge.cfd.turbulence import KOmegaSST
 
-    sim, body, _ = _slab_flow()
+    sim, body, _ = _slab_flow(nu=1e-6)   # the first fluid cells at y+ 35
     nu = sim.config.nu
     model = KOmegaSST(sim, 1e-3, 10.0, body_walls="function")
     model.advance(1e-4)   # a first step to give k some variation near the wall
@@ -140,9 +142,12 @@ def test_the_sst_wall_cells_hold_omega_at_the_blended_wall_value_and_k_free_of_w
     kk, d = k0[first, cols], d_row[first]   # the hold uses the step's starting k
     expect = np.sqrt((6 * nu / (0.075 * d * d)) ** 2 + (np.sqrt(kk) / (0.09 ** 0.25 * 0.41 * d)) ** 2)
     np.testing.assert_allclose(w[first, cols], expect, rtol=1e-6)
+    assert 0.05 * d / nu > 10.8
+    production = 0.05 ** 2 * 0.09 ** 0.25 * np.sqrt(kk) / (0.41 * d)
+    np.testing.assert_allclose(model.k.source.numpy()[g + first, g:g + grid.nx][cols], production, rtol=1e-4)
     np.testing.assert_allclose(k[first - 1, cols], k0[first, cols], rtol=1e-12)   # the solid row under it
     assert np.all(np.isfinite(sim.nu.numpy()[g:g + grid.ny, g:g + grid.nx]))
-    sim2, _, _ = _slab_flow()
+    sim2, _, _ = _slab_flow(nu=1e-6)
     model2 = KOmegaSST(sim2, 1e-3, 10.0, body_walls="resolved")
     model2.advance(1e-4)
     assert np.all(np.abs(model2.k.interior()[first - 1, cols]) < 1e-20)   # held at 0 (to 1e-30 per unit dt)
