@@ -358,7 +358,8 @@ def sst_body_walls(phi: wp.array2d(dtype=wp.float64), ext: wp.array2d(dtype=wp.f
                    dx: wp.float64, yc: wp.array(dtype=wp.float64), g: int, pos: wp.vec3d, vel: wp.vec3d,
                    nu: wp.float64, function: int, src_k: wp.array2d(dtype=wp.float64),
                    snk_k: wp.array2d(dtype=wp.float64), src_w: wp.array2d(dtype=wp.float64),
-                   snk_w: wp.array2d(dtype=wp.float64)):
+                   snk_w: wp.array2d(dtype=wp.float64), nu_eff: wp.array2d(dtype=wp.float64),
+                   gam_k: wp.array2d(dtype=wp.float64), gam_w: wp.array2d(dtype=wp.float64)):
     """The wall of an immersed body in the SST model (bridge/cfd/turbulence.py), on the box of
     ``body_wall_cells`` (its phi and ext): the sources of the cells that are held at a value (source
     R q_w, implicit sink R, R = SST_HOLD, so the stage gives q_w to round-off).
@@ -373,7 +374,9 @@ def sst_body_walls(phi: wp.array2d(dtype=wp.float64), ext: wp.array2d(dtype=wp.f
     u_tau from the cell's speed relative to the body (pos, vel: the body's pose and velocity) on
     Spalding's law, where the cell lies in the log layer (y+ > 10.8, where ln(y+)/0.41 + 5 meets y+; below,
     the model's own production): the strain rate of the cell itself spans the wall and would overstate
-    it. The production keeps the model's limiter, 10 beta* k omega."""
+    it. The production keeps the model's limiter, 10 beta* k omega. For the same reason these cells take
+    nu_t = k / omega unlimited (the limiter a1 k / (S F2) would act on that overstated S and halve the
+    eddy viscosity that carries the wall shear), with the inner diffusivities (F1 = 1 at a wall)."""
     jb = wp.tid()
     J = j0 + jb
     nj = phi.shape[0]
@@ -412,8 +415,13 @@ def sst_body_walls(phi: wp.array2d(dtype=wp.float64), ext: wp.array2d(dtype=wp.f
             sk = wp.sqrt(wp.max(k[J, I], zero))
             w_vis = wp.float64(6.0) * nu / (SST_BETA1 * ph * ph)
             w_log = sk / (wp.sqrt(wp.sqrt(SST_BETA_STAR)) * KAPPA * ph)
-            src_w[J, I] = SST_HOLD * wp.sqrt(w_vis * w_vis + w_log * w_log)
+            w_wall = wp.sqrt(w_vis * w_vis + w_log * w_log)
+            src_w[J, I] = SST_HOLD * w_wall
             snk_w[J, I] = SST_HOLD
+            nut = sk * sk / w_wall
+            nu_eff[J, I] = nu + nut
+            gam_k[J, I] = nu + SST_SIGMA_K1 * nut
+            gam_w[J, I] = nu + SST_SIGMA_W1 * nut
             xc = x0 + (wp.float64(I - g) + wp.float64(0.5)) * dx
             ur = wp.float64(0.5) * (u[J, I] + u[J, I + 1]) - rigid_velocity(xc, yc[J], pos, vel, 0)
             vr = wp.float64(0.5) * (v[J, I] + v[J + 1, I]) - rigid_velocity(xc, yc[J], pos, vel, 1)

@@ -159,7 +159,7 @@ class KOmegaSST:
             sim.L.once(_t.sst_body_walls, b["nj"],
                        [b["phi"], b["ext"], b["i0"], b["j0"], b["ni"], k.q, w.q, sim.u, sim.v, float(grid.x_faces[0]),
                         grid.dx, self._yc, g, wp.vec3d(*b["pose"]), vel, self.nu, int(self.body_walls == "function"),
-                        k.source, k.sink, w.source, w.sink])
+                        k.source, k.sink, w.source, w.sink, sim.nu, k.gamma, w.gamma])
         nu = sim.nu.numpy()[g:g + grid.ny, g:g + grid.nx]
         sim.nu_rows = nu.max(axis=1)
         sim.nu_max = float(sim.nu_rows.max())

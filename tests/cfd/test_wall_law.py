@@ -120,10 +120,10 @@ GHOST_COLS = (GHOST + 13, GHOST + 27)   # storage columns of u-faces at x = 0.13
 
 def test_the_sst_wall_cells_hold_omega_at_the_blended_wall_value_and_k_free_of_wall_flux():
     """After one step of the model on the slab: fluid cells within a cell of the wall hold omega =
-    sqrt(omega_vis^2 + omega_log^2) of their k and distance, and produce k at the log layer's rate
-    u_tau^2 beta*^(1/4) sqrt(k) / (kappa d) with u_tau of the profile; cells inside hold the mean k of
-    their fluid neighbours (no flux of k into the wall) with the wall function, k = 0 for a resolved
-    wall."""
+    sqrt(omega_vis^2 + omega_log^2) of their k and distance, take nu_t = k / omega, and produce k at
+    the log layer's rate u_tau^2 beta*^(1/4) sqrt(k) / (kappa d) with u_tau of the profile; cells
+    inside hold the mean k of their fluid neighbours (no flux of k into the wall) with the wall
+    function, k = 0 for a resolved wall."""
     from bridge.cfd.turbulence import KOmegaSST
 
     sim, body, _ = _slab_flow(nu=1e-6)   # the first fluid cells at y+ 35
@@ -142,6 +142,8 @@ def test_the_sst_wall_cells_hold_omega_at_the_blended_wall_value_and_k_free_of_w
     kk, d = k0[first, cols], d_row[first]   # the hold uses the step's starting k
     expect = np.sqrt((6 * nu / (0.075 * d * d)) ** 2 + (np.sqrt(kk) / (0.09 ** 0.25 * 0.41 * d)) ** 2)
     np.testing.assert_allclose(w[first, cols], expect, rtol=1e-6)
+    # their eddy viscosity is k / omega, not cut by the limiter a1 k / (S F2) on a strain rate that spans the wall
+    np.testing.assert_allclose(sim.nu.numpy()[g + first, g:g + grid.nx][cols] - nu, kk / expect, rtol=1e-9)
     assert 0.05 * d / nu > 10.8
     production = 0.05 ** 2 * 0.09 ** 0.25 * np.sqrt(kk) / (0.41 * d)
     np.testing.assert_allclose(model.k.source.numpy()[g + first, g:g + grid.nx][cols], production, rtol=1e-4)
