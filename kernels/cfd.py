@@ -15,7 +15,7 @@ Kernels are typed for float64 (the project's CFD precision, ``bridge.cfd.precisi
 
 import warp as wp
 
-from kernels.wall_law import friction_uplus, wall_law_ratio
+from kernels.wall_law import wall_law_ratio
 
 # Advection schemes (integer codes used inside kernels; names in bridge.cfd.advection).
 SCHEME_CENTRAL = 0
@@ -462,7 +462,6 @@ def ib_targets(q: wp.array2d(dtype=wp.float64), phi: wp.array2d(dtype=wp.float64
                x0: wp.float64, dx: wp.float64, xoff: wp.float64, yc: wp.array(dtype=wp.float64),
                pos: wp.vec3d, vel: wp.vec3d, comp: int, i0: int, j0: int, ni: int,
                ilo: int, ihi: int, jlo: int, jhi: int, order: int, wall_law: int, nu: wp.float64,
-               nu_eff: wp.array2d(dtype=wp.float64),
                target: wp.array2d(dtype=wp.float64), state: wp.array2d(dtype=wp.int32)):
     """Direct-forcing target of each face in the box (state: 0 fluid, 1 solid, 2 interface).
 
@@ -471,13 +470,10 @@ def ib_targets(q: wp.array2d(dtype=wp.float64), phi: wp.array2d(dtype=wp.float64
     interface point (distance d found from phi along the line) and the next fluid face:
     q_f = q_b + (q_o - q_b) d / (d + h) (``order`` 1), or the quadratic through q_b, q_o and the face
     after q_o (``order`` 2); estimates from several lines are averaged. ``wall_law`` 1 (with ``order``
-    1): the wall function of a turbulent flow at high Reynolds number - q_f = q_b + (q_o - q_b) r. For a
-    component across its line (u on a vertical line, v on a horizontal one: the one that carries the wall
-    shear), r makes the stress the momentum step transmits between q_o and q_f, nu_c (q_o - q_f) / h_o
-    with nu_c the corner viscosity of ``nu_eff`` that step uses, equal to the wall law's u_tau^2, u_tau
-    from |q_o - q_b| at q_o's wall distance phi_o on Spalding's law (``kernels.wall_law``, molecular
-    ``nu``), r kept in [0, 1]. For the component along its line (towards the wall), r = u(phi_f) /
-    u(phi_o) on Spalding's profile (phi_f / phi_o, linear, in the sublayer).
+    1): the wall function of a turbulent flow at high Reynolds number - q_f = q_b + (q_o - q_b) r with r
+    = u(phi_f) / u(phi_o) on Spalding's law of the wall through q_o (``kernels.wall_law``; phi: the
+    faces' distances to the wall, u_tau from |q_o - q_b| and the molecular ``nu``); r = phi_f / phi_o,
+    the linear profile, when the reference face lies in the viscous sublayer.
     Only faces with ilo <= I < ihi and jlo <= J < jhi are updated (boundary faces excluded);
     reads ``q`` and writes ``target``/``state`` only, so the result does not depend on order.
     """
@@ -536,23 +532,7 @@ def ib_targets(q: wp.array2d(dtype=wp.float64), phi: wp.array2d(dtype=wp.float64
                             r = d / (d + ho)
                             po = phi[jb - dj, ib - di]
                             if wall_law != 0 and po > ph:
-                                speed = wp.abs(qo - qb)
-                                r = wall_law_ratio(speed, po, ph, nu)
-                                if speed > wp.float64(0.0) and ((comp == 0 and dj != 0) or (comp == 1 and di != 0)):
-                                    up = friction_uplus(speed * po / nu)
-                                    nc = wp.float64(0.0)
-                                    if comp == 0:
-                                        Jc = J + (1 - dj) // 2   # the v-face row between the two u-faces
-                                        nc = wp.float64(0.25) * (nu_eff[Jc - 1, I - 1] + nu_eff[Jc - 1, I]
-                                                                 + nu_eff[Jc, I - 1] + nu_eff[Jc, I])
-                                    else:
-                                        Ic = I + (1 - di) // 2   # the u-face column between the two v-faces
-                                        nc = wp.float64(0.25) * (nu_eff[J - 1, Ic - 1] + nu_eff[J, Ic - 1]
-                                                                 + nu_eff[J - 1, Ic] + nu_eff[J, Ic])
-                                    if up > wp.float64(0.0) and nc > wp.float64(0.0):
-                                        u_tau = speed / up
-                                        r = wp.clamp(wp.float64(1.0) - u_tau * u_tau * ho / (nc * speed),
-                                                     wp.float64(0.0), wp.float64(1.0))
+                                r = wall_law_ratio(wp.abs(qo - qb), po, ph, nu)
                             acc += qb + (qo - qb) * r
                         cnt += wp.float64(1.0)
                 if cnt > wp.float64(0.0):

@@ -376,7 +376,7 @@ def run_case(shape, case: ForcedCase | StaticCase, quality: Quality, checkpoint:
 
 def _march(flow, polys, case, q, checkpoint, checkpoint_every, progress, label) -> ForceRecord:
     """Run ``flow`` to the case's end time, with checkpoints and progress (run_case)."""
-    from bridge.cfd import NaNMonitor
+    from bridge.cfd import FlowDiverged, NaNMonitor
 
     key = case_key(polys, case, q)
     names = ("t", "lift", "drag", "moment", "motion")
@@ -396,8 +396,14 @@ def _march(flow, polys, case, q, checkpoint, checkpoint_every, progress, label) 
     t0, t_start = time.perf_counter(), flow.t
     next_note = flow.t + 0.1 * t_end
     while flow.t < t_end - 1e-12 * t_end:
-        flow.step(flow.stable_dt())
+        dt = flow.stable_dt()
+        if not (np.isfinite(dt) and dt > 0.0):   # a non-finite velocity makes the limit infinite or NaN
+            raise FlowDiverged(f"the time step became {dt!r} at t = {flow.t:.6g} (step {flow.n_steps}): the flow "
+                               "is no longer finite")
+        flow.step(dt)
         fx, fy, mz = flow.last_force   # all parts about the same reference point
+        if not np.all(np.isfinite((fx, fy, mz))):
+            raise FlowDiverged(f"non-finite loads at t = {flow.t:.6g} (step {flow.n_steps})")
         rec["t"].append(flow.t)
         rec["lift"].append(fy)
         rec["drag"].append(fx)

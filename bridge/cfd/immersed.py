@@ -75,7 +75,6 @@ class ImmersedBody:
             raise ValueError(f"order: interpolation order 1 or 2, got {order}")
         self.order = order
         self.wall_law = None   # molecular nu of the wall function (set_wall_function); None: no wall function
-        self._nu_eff = wp.zeros((1, 1), dtype=WP_DTYPE, device=launcher.device)   # its nu + nu_t field
         self.polygon, self.motion, self.grid, self.L = polygon, motion, grid, launcher
         dev = launcher.device
         self.margin = margin
@@ -100,21 +99,16 @@ class ImmersedBody:
         self.inertia = polygon.polar_moment_centroid
         self._centroid_body = polygon.centroid
 
-    def set_wall_function(self, nu: float | None, nu_eff=None) -> None:
-        """Interface faces take the wall function instead of the linear profile (a turbulent flow at
-        high Reynolds number, ``kernels.cfd.ib_targets``; ``nu``: the molecular viscosity; ``nu_eff``:
-        the flow's nu + nu_t cell field, storage layout, which the momentum step uses), or the linear
-        profile again (None). Needs ``order`` 1."""
+    def set_wall_function(self, nu: float | None) -> None:
+        """Interface faces take Spalding's law of the wall instead of the linear profile (a turbulent
+        flow at high Reynolds number, ``kernels.cfd.ib_targets``; ``nu``: the molecular viscosity), or
+        the linear profile again (None). Needs ``order`` 1."""
         if nu is not None:
             if self.order != 1:
                 raise ValueError(f"the wall function needs interpolation order 1, not {self.order}")
             if not nu > 0:
                 raise ValueError(f"wall function: nu must be > 0, got {nu}")
-        if nu is not None and nu_eff is None:
-            raise ValueError("the wall function needs the flow's nu + nu_t field (nu_eff)")
         self.wall_law = None if nu is None else float(nu)
-        if nu_eff is not None:
-            self._nu_eff = nu_eff
 
     # --- geometry ------------------------------------------------------------------------------
     def _box(self, comp, pose):
@@ -171,7 +165,7 @@ class ImmersedBody:
                                                  self.pos, self.vel, comp, b["i0"], b["j0"], b["ni"],
                                                  ilo, ihi, jlo, jhi, self.order, int(self.wall_law is not None),
                                                  0.0 if self.wall_law is None else float(self.wall_law),
-                                                 self._nu_eff, b["target"], b["state"]])
+                                                 b["target"], b["state"]])
         self._close_targets()
         for comp, q in ((0, u), (1, v)):
             b = self.boxes[comp]

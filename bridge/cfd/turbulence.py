@@ -100,7 +100,7 @@ class KOmegaSST:
                         "nj": 0, "pose": None, "phi": wp.zeros((1, 1), dtype=wp.float64, device=dev),
                         "ext": wp.zeros((1, 1), dtype=wp.float64, device=dev)} for b in bodies]
         for b in bodies:
-            b.set_wall_function(self.nu if body_walls == "function" else None, sim.nu)
+            b.set_wall_function(self.nu if body_walls == "function" else None)
         self.k = TransportedScalar(sim, "k", sides_k, initial=k_inf)
         self.omega = TransportedScalar(sim, "omega", sides_w, initial=omega_inf)
         self.update()

@@ -72,8 +72,8 @@ def test_the_ratio_follows_the_profile_and_is_linear_in_the_sublayer():
 # --- the immersed boundary's wall function and the SST model's wall cells ---------------------------
 
 def _slab_flow(u_tau=0.05, nu=1e-5, wall_y=0.0213):
-    """A horizontal slab (top at ``wall_y``) in a grid with cells 4e-3 high (y+ 20 per cell at nu 1e-5), u
-    set to Spalding's profile above it; returns the simulation, its body and the profile."""
+    """A horizontal slab (top at ``wall_y``) in a grid with cells 4e-3 high (y+ 20 per cell), u set to
+    Spalding's profile above it; returns the simulation, its body and the profile."""
     from bridge.cfd import CartesianGrid, FlowConfig, Polygon, Simulation, Stationary
 
     grid = CartesianGrid(np.linspace(0.0, 0.4, 41), np.linspace(0.0, 0.2, 51))
@@ -89,7 +89,7 @@ def _slab_flow(u_tau=0.05, nu=1e-5, wall_y=0.0213):
 
 
 def _forced_u(sim, body, wall_function):
-    body.set_wall_function(sim.config.nu if wall_function else None, sim.nu)
+    body.set_wall_function(sim.config.nu if wall_function else None)
     body.update(0.0)
     before = sim.u.numpy().copy()
     body.apply(sim.u, sim.v, 0)
@@ -100,45 +100,19 @@ def _forced_u(sim, body, wall_function):
     return J, I, before, sim.u.numpy()
 
 
-def _top_faces(J, I):
-    keep = (I > GHOST_COLS[0]) & (I < GHOST_COLS[1])   # the faces above the top, away from the ends
-    return J[keep], I[keep]
-
-
-def test_the_wall_function_transmits_the_wall_laws_shear_stress():
-    """Faces next to a flat immersed wall, under Spalding's profile and an eddy viscosity uneven across it, are
-    set so that the stress the momentum step carries between them and the next face up, nu_c (u_o - u_f)
-    / h with nu_c the mean of the four cells around that corner, is the wall law's u_tau^2 (u_tau of the
-    profile, 0.05) to round-off; where nu_c is too small for that, the face takes the wall's velocity."""
-    rng = np.random.default_rng(3)
+def test_the_wall_function_reconstructs_a_law_of_the_wall_profile_exactly():
+    """Faces next to a flat immersed wall, given Spalding's profile above them, get the profile's value
+    back (to the root-finder's round-off), where the linear profile of the laminar forcing is far off:
+    the forced face at y+ ~ 5-25 lies between the sublayer and the log layer."""
     sim, body, profile = _slab_flow()
-    g = GHOST
-    nu_field = sim.nu.numpy()
-    # 10-20 times the molecular 1e-5, uneven across the wall (even along it: the mass closure of cells whose
-    # four faces are all forced, bridge/cfd/immersed.py, would otherwise move the targets by a few per cent)
-    nu_field[:, :] = 1e-4 * (1 + rng.random(nu_field.shape[0]))[:, None]
     J, I, before, after = _forced_u(sim, body, wall_function=True)
-    J, I = _top_faces(J, I)
-    assert J.size > 5 and np.all(after[J + 1, I] == before[J + 1, I])   # the reference faces are free
-    nc = 0.25 * (nu_field[J, I - 1] + nu_field[J, I] + nu_field[J + 1, I - 1] + nu_field[J + 1, I])
-    yc = sim.grid.storage_y_centres()
-    tau = nc * (after[J + 1, I] - after[J, I]) / (yc[J + 1] - yc[J])
-    np.testing.assert_allclose(tau, 0.05 ** 2, rtol=1e-9)
-    assert np.all(after[J, I] > 0)
-    # a viscosity far too small to carry u_tau^2 over the gap: the forced face is held at the wall's velocity
+    top = J[(I > GHOST_COLS[0]) & (I < GHOST_COLS[1])]   # the faces above the top, away from the ends
+    cols = I[(I > GHOST_COLS[0]) & (I < GHOST_COLS[1])]
+    assert top.size > 5
+    np.testing.assert_allclose(after[top, cols], before[top, cols], rtol=1e-9)
     sim2, body2, _ = _slab_flow()
-    sim2.nu.numpy()[:, :] = 1e-7
-    J2, I2, _, after2 = _forced_u(sim2, body2, wall_function=True)
-    J2, I2 = _top_faces(J2, I2)
-    assert np.all(after2[J2, I2] == 0.0)
-    # the laminar forcing's straight line is something else
-    sim3, body3, _ = _slab_flow()
-    sim3.nu.numpy()[:, :] = nu_field
-    J3, I3, before3, after3 = _forced_u(sim3, body3, wall_function=False)
-    J3, I3 = _top_faces(J3, I3)
-    tau3 = nc * (after3[J3 + 1, I3] - after3[J3, I3]) / (yc[J3 + 1] - yc[J3])
-    assert np.max(np.abs(tau3 / 0.05 ** 2 - 1)) > 0.1
-    del g, profile
+    J2, I2, before2, after2 = _forced_u(sim2, body2, wall_function=False)
+    assert np.max(np.abs(after2[top, cols] / before2[top, cols] - 1)) > 0.1
 
 
 GHOST_COLS = (GHOST + 13, GHOST + 27)   # storage columns of u-faces at x = 0.13-0.27, inside the slab (0.1-0.3)
