@@ -5,6 +5,7 @@ u+ = ln(y+) / 0.41 + 5.0 above it (the TMR constants).
 """
 
 import numpy as np
+import pytest
 import warp as wp
 
 from bridge.cfd.grids import GHOST
@@ -154,3 +155,17 @@ def test_the_sst_wall_cells_hold_omega_at_the_blended_wall_value_and_k_free_of_w
     model2.advance(1e-4)
     assert np.all(np.abs(model2.k.interior()[first - 1, cols]) < 1e-20)   # held at 0 (to 1e-30 per unit dt)
     assert sim2.bodies[0].wall_law is None and sim.bodies[0].wall_law == nu
+
+
+def test_the_wall_function_refuses_what_it_cannot_do():
+    from bridge.cfd.turbulence import KOmegaSST
+
+    sim, body, _ = _slab_flow()
+    body.order = 2
+    with pytest.raises(ValueError, match="interpolation order 1"):
+        body.set_wall_function(1e-5)
+    body.order = 1
+    with pytest.raises(ValueError, match="nu must be > 0"):
+        body.set_wall_function(0.0)
+    with pytest.raises(ValueError, match="body_walls: one of function, resolved"):
+        KOmegaSST(sim, 1e-3, 10.0, body_walls="log")
