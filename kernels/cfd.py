@@ -470,10 +470,13 @@ def ib_targets(q: wp.array2d(dtype=wp.float64), phi: wp.array2d(dtype=wp.float64
     interface point (distance d found from phi along the line) and the next fluid face:
     q_f = q_b + (q_o - q_b) d / (d + h) (``order`` 1), or the quadratic through q_b, q_o and the face
     after q_o (``order`` 2); estimates from several lines are averaged. ``wall_law`` 1 (with ``order``
-    1): the wall function of a turbulent flow at high Reynolds number - q_f = q_b + (q_o - q_b) r with r
-    = u(phi_f) / u(phi_o) on Spalding's law of the wall through q_o (``kernels.wall_law``; phi: the
-    faces' distances to the wall, u_tau from |q_o - q_b| and the molecular ``nu``); r = phi_f / phi_o,
-    the linear profile, when the reference face lies in the viscous sublayer.
+    1): the wall function of a turbulent flow at high Reynolds number - for the component across the
+    line (u on a vertical line, v on a horizontal one), q_f = q_b + (q_o - q_b) r with r = u(phi_f) /
+    u(phi_o) on Spalding's law of the wall through q_o (``kernels.wall_law``; phi: the faces' distances
+    to the wall, u_tau from |q_o - q_b| and the molecular ``nu``; r = phi_f / phi_o, the linear profile,
+    when the reference face lies in the viscous sublayer). The component along the line, which meets
+    the wall, keeps the straight line: the law of the wall is a tangential profile, and applied to the
+    normal velocity of a moving deck it made its heave damping change sign (docs/aero.md).
     Only faces with ilo <= I < ihi and jlo <= J < jhi are updated (boundary faces excluded);
     reads ``q`` and writes ``target``/``state`` only, so the result does not depend on order.
     """
@@ -531,7 +534,11 @@ def ib_targets(q: wp.array2d(dtype=wp.float64), phi: wp.array2d(dtype=wp.float64
                         else:
                             r = d / (d + ho)
                             po = phi[jb - dj, ib - di]
-                            if wall_law != 0 and po > ph:
+                            # the wall function for the component across the line only (u on a vertical
+                            # line, v on a horizontal one: the tangential one at a wall that the line meets
+                            # square); the component along the line, towards the wall, keeps the straight line
+                            tangential = (comp == 0 and dj != 0) or (comp == 1 and di != 0)
+                            if wall_law != 0 and po > ph and tangential:
                                 r = wall_law_ratio(wp.abs(qo - qb), po, ph, nu)
                             acc += qb + (qo - qb) * r
                         cnt += wp.float64(1.0)

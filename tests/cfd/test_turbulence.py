@@ -110,12 +110,12 @@ def test_flat_plate_skin_friction_on_a_coarse_grid():
 def test_the_immersed_flat_plate_with_the_wall_function():
     """TMR's flat plate at Re 5e6 as an immersed body with Spalding's wall function (tools/validate_turbulence.py
     ibplate), cells 8e-4 high at the plate (the reference face at y+ ~ 225): c_f at x = 0.97 within 6 % of TMR's
-    resolved 0.00271-0.00272 (measured 0.002828, +4.2 %), settled, and the plate's drag force within 8 % of the
-    wall-law friction integrated along both sides (measured -4.3 %). docs/validation.md has the y+ study
-    (-5.8 % at y+ 107, +25 % at 494)."""
+    resolved 0.00271-0.00272 (measured 0.002769, +2.0 %), settled, and the plate's drag force within 10 % of the
+    wall-law friction integrated along both sides of its flat part (measured +6.7 %; the force also holds the
+    wedge ends' drag). docs/validation.md has the y+ study."""
     r = vt.ibplate(dy=8e-4, t_end=2.5, threads=1)
     assert 150 < r["y+_0.97"] < 300
     assert abs(r["cf_0.97"] / 0.002715 - 1) < 0.06, r["cf_0.97"]
     (_, c1, _), (_, c2, _) = r["cf_0.97_history"][-2:]
     assert abs(c2 / c1 - 1) < 1e-3
-    assert abs(r["drag_force"] / r["friction_from_cf"] - 1) < 0.08, (r["drag_force"], r["friction_from_cf"])
+    assert abs(r["drag_force"] / r["friction_from_cf"] - 1) < 0.10, (r["drag_force"], r["friction_from_cf"])
