@@ -396,10 +396,14 @@ def shift_outflow(u: wp.array2d(dtype=wp.float64), delta: wp.float64, g: int, nx
 # ----------------------------------------------------------------------------- immersed boundary
 
 @wp.func
-def polygon_signed_distance(px: wp.float64, py: wp.float64, verts: wp.array(dtype=wp.vec2d)):
-    """Signed distance from (px, py) to a closed polygon (negative inside; even-odd rule)."""
+def polygon_nearest(px: wp.float64, py: wp.float64, verts: wp.array(dtype=wp.vec2d)):
+    """(signed distance, k, t) from (px, py) to a closed polygon: the distance negative inside (even-odd
+    rule), k the nearest segment (verts[k] -> verts[k + 1], as a float; the first of equals) and t in
+    [0, 1] the nearest point's place on it."""
     n = verts.shape[0]
     dmin = wp.float64(1.0e300)
+    kmin = int(0)  # noqa: UP018 (Warp: a dynamic variable, mutated in the loop)
+    tmin = wp.float64(0.0)
     inside = int(0)  # noqa: UP018 (Warp: a dynamic variable, mutated in the loop)
     for k in range(n):
         a = verts[k]
@@ -411,7 +415,11 @@ def polygon_signed_distance(px: wp.float64, py: wp.float64, verts: wp.array(dtyp
         t = wp.clamp((wx * ex + wy * ey) / (ex * ex + ey * ey), wp.float64(0.0), wp.float64(1.0))
         dx = wx - t * ex
         dy = wy - t * ey
-        dmin = wp.min(dmin, dx * dx + dy * dy)
+        d2 = dx * dx + dy * dy
+        if d2 < dmin:
+            dmin = d2
+            kmin = k
+            tmin = t
         if (a[1] > py) != (b[1] > py):
             xc = a[0] + (py - a[1]) * ex / ey
             if px < xc:
@@ -419,7 +427,13 @@ def polygon_signed_distance(px: wp.float64, py: wp.float64, verts: wp.array(dtyp
     d = wp.sqrt(dmin)
     if inside == 1:
         d = -d
-    return d
+    return wp.vec3d(d, wp.float64(kmin), tmin)
+
+
+@wp.func
+def polygon_signed_distance(px: wp.float64, py: wp.float64, verts: wp.array(dtype=wp.vec2d)):
+    """Signed distance from (px, py) to a closed polygon (negative inside; even-odd rule)."""
+    return polygon_nearest(px, py, verts)[0]
 
 
 @wp.kernel

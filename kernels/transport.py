@@ -18,7 +18,7 @@ non-negative (the positivity k and omega need). Conservative: the face fluxes te
 
 import warp as wp
 
-from kernels.cfd import polygon_signed_distance, rigid_velocity, upwind_flux
+from kernels.cfd import polygon_nearest, polygon_signed_distance, rigid_velocity, upwind_flux
 from kernels.wall_law import KAPPA, friction_uplus
 
 
@@ -186,40 +186,26 @@ def polygon_distance_normal(px: wp.float64, py: wp.float64, verts: wp.array(dtyp
     """(signed distance, n_x, n_y) of (px, py) to a closed polygon: the distance as
     ``kernels.cfd.polygon_signed_distance`` (negative inside), n the unit vector from the nearest
     boundary point to the point (a normal of the nearest segment when the point lies on it)."""
-    n = verts.shape[0]
-    dmin = wp.float64(1.0e300)
+    r = polygon_nearest(px, py, verts)
+    k = int(r[1])
+    a = verts[k]
+    b = verts[(k + 1) % verts.shape[0]]
+    ex = b[0] - a[0]
+    ey = b[1] - a[1]
+    dx = px - a[0] - r[2] * ex
+    dy = py - a[1] - r[2] * ey
+    d2 = dx * dx + dy * dy
     nx = wp.float64(0.0)
-    ny = wp.float64(1.0)
-    inside = int(0)  # noqa: UP018 (Warp: a dynamic variable, mutated in the loop)
-    for k in range(n):
-        a = verts[k]
-        b = verts[(k + 1) % n]
-        ex = b[0] - a[0]
-        ey = b[1] - a[1]
-        wx = px - a[0]
-        wy = py - a[1]
-        t = wp.clamp((wx * ex + wy * ey) / (ex * ex + ey * ey), wp.float64(0.0), wp.float64(1.0))
-        dx = wx - t * ex
-        dy = wy - t * ey
-        d2 = dx * dx + dy * dy
-        if d2 < dmin:
-            dmin = d2
-            if d2 > wp.float64(1.0e-28):
-                r = wp.sqrt(d2)
-                nx = dx / r
-                ny = dy / r
-            else:
-                r = wp.sqrt(ex * ex + ey * ey)
-                nx = ey / r
-                ny = -ex / r
-        if (a[1] > py) != (b[1] > py):
-            xc = a[0] + (py - a[1]) * ex / ey
-            if px < xc:
-                inside = 1 - inside
-    d = wp.sqrt(dmin)
-    if inside == 1:
-        d = -d
-    return wp.vec3d(d, nx, ny)
+    ny = wp.float64(0.0)
+    if d2 > wp.float64(1.0e-28):
+        h = wp.sqrt(d2)
+        nx = dx / h
+        ny = dy / h
+    else:
+        h = wp.sqrt(ex * ex + ey * ey)
+        nx = ey / h
+        ny = -ex / h
+    return wp.vec3d(r[0], nx, ny)
 
 
 @wp.kernel
