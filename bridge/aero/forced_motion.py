@@ -72,7 +72,7 @@ class Quality:
     background_coarsening: int = 2
     body_margin: float = 0.35
     # "laminar", or "sst": the k-omega SST model (bridge.cfd.turbulence, the 2003 variant) with Spalding's
-    # wall function on the section (single grid only, for now), at the deck's Reynolds number
+    # wall function on the section (either grid), at the deck's Reynolds number
     turbulence: str = "laminar"
 
     def __post_init__(self):
@@ -360,9 +360,6 @@ def run_case(shape, case: ForcedCase | StaticCase, quality: Quality, checkpoint:
 
     q = quality
     polys = _polygons(shape)
-    if q.overset and q.turbulence != "laminar":
-        raise InputError("aero.turbulence", q.turbulence, 'laminar on the overset grids (grid = "overset"); the SST '
-                         'model runs on the single grid only (the overset exchange of k and omega is not built yet)')
     try:
         flow = _overset_flow(q, polys, case, threads) if q.overset else _SingleGridFlow(q, polys, case, threads)
     except ValueError as err:   # the section and the preset's grid do not fit together
@@ -476,13 +473,10 @@ class _SingleGridFlow:
         return f"{self.sim.grid.nx} x {self.sim.grid.ny} cells" + ("" if self.model is None else ", SST")
 
     def _arrays(self) -> dict:
-        """The state a resumed run needs to continue bit for bit: the flow's, and with SST k, omega and what
-        the last coefficient pass left for the next step (computed from the previous step's k and omega):
-        the flow's nu + nu_t and the diffusivities of the time-step limit."""
+        """The state a resumed run needs to continue bit for bit: the flow's, and the SST model's."""
         out = {name: getattr(self.sim, name) for name in ("u", "v", "p")}
         if self.model is not None:
-            m = self.model
-            out.update(k=m.k.q, omega=m.omega.q, nu_eff=self.sim.nu, k_gamma=m.k.gamma, omega_gamma=m.omega.gamma)
+            out.update(self.model.state_arrays())
         return out
 
     def checkpoint_arrays(self) -> dict:
@@ -493,11 +487,7 @@ class _SingleGridFlow:
             a.assign(arrays[name])
         self.sim.t, self.sim.n_steps = t, n_steps
         if self.model is not None:
-            from bridge.cfd.grids import GHOST
-
-            g, grid = GHOST, self.sim.grid
-            rows = self.sim.nu.numpy()[g:g + grid.ny, g:g + grid.nx].max(axis=1)
-            self.sim.nu_rows, self.sim.nu_max = rows, float(rows.max())
+            self.model.restored()
 
 
 def _overset_flow(q: Quality, polys, case, threads):
@@ -528,6 +518,10 @@ def _overset_flow(q: Quality, polys, case, threads):
     config = FlowConfig(nu=1.0 / q.reynolds, advection="vanleer", cfl=q.cfl, threads=threads, bc=bc)
     pair = OversetPair(background, body, config, case.motion(), polygon=polys)
     pair.set_uniform_flow(1.0)
+    if q.turbulence == "sst":
+        from bridge.cfd.turbulence import OversetSST, freestream_turbulence
+
+        OversetSST(pair, *freestream_turbulence(1.0, 1.0 / q.reynolds), body_walls="function")
     return pair
 
 

@@ -20,7 +20,7 @@ Keys (all optional):
     turbulence            "laminar": the preset's low Reynolds number, no turbulence model (default); "sst": the
                           k-omega SST model (2003 variant) with Spalding's wall function on the section, at the
                           deck's Reynolds number Re = wind_speed_m_s B / nu_air ([air] kinematic viscosity);
-                          single grid only (bridge/cfd/turbulence.py, docs/cfd.md)
+                          on either grid (bridge/cfd/turbulence.py, docs/cfd.md)
     wind_speed_m_s        the wind speed that sets the Reynolds number with turbulence = "sst" (default the
                           thesis's 50 m/s: Re = 1.05e8 for the Great Belt's 31 m); the derivatives are
                           per unit wind speed either way
@@ -61,9 +61,6 @@ class AeroOptions:
 
         if self.turbulence not in TURBULENCE:
             raise InputError("aero.turbulence", self.turbulence, f"one of {', '.join(TURBULENCE)}")
-        if self.turbulence != "laminar" and self.grid != "single":
-            raise InputError("aero.turbulence", self.turbulence, 'laminar with grid = "overset" (the SST model runs '
-                             "on the single grid only, for now)")
         check_range("aero.wind_speed_m_s", self.wind_speed_m_s, 0.0, 200.0, low_open=True)
 
         if self.grid not in GRIDS:

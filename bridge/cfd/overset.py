@@ -293,6 +293,7 @@ class OversetPair:
         self.body.hooks.append(self._fringe)
         self.background.hooks.append(self._hole)
         self._psi_hist: list[tuple[float, np.ndarray]] = []   # (t, body psi) of the last two steps
+        self.model = None   # a turbulence model of both grids (bridge.cfd.turbulence.OversetSST), or None
         self.t = 0.0
         self.n_steps = 0
 
@@ -411,16 +412,20 @@ class OversetPair:
 
     # --- step ---------------------------------------------------------------------------------
     def stable_dt(self) -> float:
-        return min(self.background.stable_dt(), self.body.stable_dt())
+        dt = min(self.background.stable_dt(), self.body.stable_dt())
+        return dt if self.model is None else min(dt, self.model.stable_dt())
 
     def step(self, dt: float | None = None) -> float:
         """Advance both grids by one step: the background first (hole from the body grid extrapolated
-        to the new time), then the body grid (fringe from the background at the new time)."""
+        to the new time), then the body grid (fringe from the background at the new time); then the
+        turbulence model, if any, with the new velocities."""
         dt = self.stable_dt() if dt is None else float(dt)
         self.background.step(dt)
         self.body.step(dt)
         self.t = self.body.t
         self._psi_hist = [self._psi_hist[-1], (self.t, stream_function(self.body))]
+        if self.model is not None:
+            self.model.advance(dt)
         self.n_steps += 1
         return dt
 
@@ -441,17 +446,19 @@ class OversetPair:
 
     def describe(self) -> str:
         b, g = self.background.grid, self.body.grid
-        return f"{b.nx} x {b.ny} + body {g.nx} x {g.ny} cells"
+        return f"{b.nx} x {b.ny} + body {g.nx} x {g.ny} cells" + ("" if self.model is None else ", SST")
 
     # --- checkpoint ---------------------------------------------------------------------------
     def checkpoint_arrays(self) -> dict[str, np.ndarray]:
-        """Everything a restart needs (with ``t`` and ``n_steps``): both grids' u, v, p and the body
-        grid's stream function of the last two steps (the hole's extrapolation)."""
+        """Everything a restart needs (with ``t`` and ``n_steps``): both grids' u, v, p, the body grid's
+        stream function of the last two steps (the hole's extrapolation) and the turbulence model's state."""
         out = {f"{name}/{f}": getattr(sim, f).numpy().copy() for name, sim in (("background", self.background),
                                                                              ("body", self.body)) for f in "uvp"}
         out["psi_times"] = np.array([t for t, _ in self._psi_hist])
         for k, (_, psi) in enumerate(self._psi_hist):
             out[f"psi_{k}"] = psi
+        if self.model is not None:
+            out.update({name: a.numpy().copy() for name, a in self.model.state_arrays().items()})
         return out
 
     def restore_arrays(self, arrays: dict[str, np.ndarray], t: float, n_steps: int) -> None:
@@ -463,3 +470,7 @@ class OversetPair:
         times = np.atleast_1d(arrays["psi_times"])
         self._psi_hist = [(float(tk), np.asarray(arrays[f"psi_{k}"])) for k, tk in enumerate(times)]
         self._fringe._t = self._hole._t = None
+        if self.model is not None:
+            for name, a in self.model.state_arrays().items():
+                a.assign(arrays[name])
+            self.model.restored()

@@ -27,7 +27,8 @@ velocity and the k, omega of the step's start.
 Boundaries: an inflow side takes the freestream (k_inf, omega_inf); an outflow or slip side zero
 gradient; a no-slip side k = 0 and omega = 60 nu / (beta_1 dy_1^2) on the wall (dy_1 the height of
 the first cell: Menter's wall value, as TMR recommends), valid when the first cell is in the viscous
-sublayer (y+ of order 1). Walls of immersed bodies and wall functions are not in this module yet.
+sublayer (y+ of order 1). Walls of immersed bodies: ``KOmegaSST``'s ``body_walls`` (Spalding's wall
+function or a resolved wall; ``kernels.transport.sst_body_walls``). On an overset pair: ``OversetSST``.
 """
 
 from __future__ import annotations
@@ -41,7 +42,7 @@ from .grids import GHOST
 from .launch import ROW0
 from .transport import TransportedScalar, advance_pair, wall_distance
 
-__all__ = ["KOmegaSST", "freestream_turbulence"]
+__all__ = ["KOmegaSST", "OversetSST", "freestream_turbulence"]
 
 BETA_1 = 0.075
 
@@ -60,11 +61,13 @@ class KOmegaSST:
     """SST-2003 on a ``Simulation``'s grid (module doc), with the walls of its immersed bodies
     (``sim.bodies``) treated by ``body_walls``: "function" (Spalding's wall function: for walls whose
     first fluid point may lie in the log layer, the deck at full scale) or "resolved" (k = 0 at the wall,
-    for grids with the first point in the viscous sublayer)."""
+    for grids with the first point in the viscous sublayer). ``far_walls``: (polygon, pose) pairs of walls
+    that are not bodies of this grid but count in its wall distance (an overset background: the body of
+    the body grid at its starting pose)."""
 
     BODY_WALLS = ("function", "resolved")
 
-    def __init__(self, sim, k_inf: float, omega_inf: float, body_walls: str = "function"):
+    def __init__(self, sim, k_inf: float, omega_inf: float, body_walls: str = "function", far_walls=()):
         if not (k_inf >= 0 and omega_inf > 0):
             raise ValueError(f"k_inf >= 0 and omega_inf > 0 needed, got {k_inf}, {omega_inf}")
         if body_walls not in self.BODY_WALLS:
@@ -90,6 +93,8 @@ class KOmegaSST:
         for b in bodies:   # the bodies' distances at the starting pose, everywhere
             d = np.minimum(d, wall_distance(grid, [b.polygon], tuple(float(c) for c in b.motion.pose(sim.t)),
                                             device=str(dev)))
+        for polygon, pose in far_walls:
+            d = np.minimum(d, wall_distance(grid, [polygon], tuple(float(c) for c in pose), device=str(dev)))
         self.wall_distance = d
         pad = lambda a: np.pad(np.minimum(a, 1e100), GHOST, mode="edge")  # noqa: E731
         self._dist = wp.array(pad(d), dtype=wp.float64, device=dev)
@@ -184,7 +189,123 @@ class KOmegaSST:
         self.update()
         advance_pair(self.k, self.omega, dt)
 
+    def state_arrays(self) -> dict:
+        """What a resumed run needs to continue bit for bit: k, omega and what the last coefficient pass
+        left for the next step (from the previous step's k and omega): the flow's nu + nu_t and the
+        diffusivities of the time-step limit (Warp arrays; ``restored`` after assigning them)."""
+        return {"k": self.k.q, "omega": self.omega.q, "nu_eff": self.sim.nu, "k_gamma": self.k.gamma,
+                "omega_gamma": self.omega.gamma}
+
+    def restored(self) -> None:
+        """After ``state_arrays`` were assigned: the flow's viscous time-step limit from nu + nu_t."""
+        g, grid = GHOST, self.sim.grid
+        rows = self.sim.nu.numpy()[g:g + grid.ny, g:g + grid.nx].max(axis=1)
+        self.sim.nu_rows, self.sim.nu_max = rows, float(rows.max())
+
+    def hold(self, J: np.ndarray, I: np.ndarray, k: np.ndarray, omega: np.ndarray) -> None:
+        """Hold the cells (storage indices J, I) at k and omega over the next ``advance_pair`` (after
+        ``update``): source R q, sink R, as the walls' cells (``kernels.transport.SST_HOLD``)."""
+        hold = float(_t.SST_HOLD.value)
+        for scalar, values in ((self.k, k), (self.omega, omega)):
+            src, snk = scalar.source.numpy(), scalar.sink.numpy()
+            src[J, I] = hold * np.asarray(values)
+            snk[J, I] = hold
+            if not self.sim.L.device.is_cpu:   # .numpy() was a copy
+                scalar.source.assign(src)
+                scalar.sink.assign(snk)
+
     def nu_t(self) -> np.ndarray:
         """(ny, nx) eddy viscosity of the current state."""
         g, grid = GHOST, self.sim.grid
         return self.sim.nu.numpy()[g:g + grid.ny, g:g + grid.nx] - self.nu
+
+
+def _bilinear(field: np.ndarray, xc: np.ndarray, yc: np.ndarray, px: np.ndarray, py: np.ndarray) -> np.ndarray:
+    """Bilinear interpolation of a cell field (ny, nx) on the centres xc (uniform), yc (increasing) at the
+    points (px, py), clamped to the lattice: second order, and it keeps k and omega positive."""
+    dx = xc[1] - xc[0]
+    fi = np.clip((px - xc[0]) / dx, 0.0, xc.size - 1.0)
+    i = np.minimum(fi.astype(int), xc.size - 2)
+    a = fi - i
+    j = np.clip(np.searchsorted(yc, py) - 1, 0, yc.size - 2)
+    b = np.clip((py - yc[j]) / (yc[j + 1] - yc[j]), 0.0, 1.0)
+    return ((1 - b) * ((1 - a) * field[j, i] + a * field[j, i + 1])
+            + b * ((1 - a) * field[j + 1, i] + a * field[j + 1, i + 1]))
+
+
+class OversetSST:
+    """SST-2003 on an overset pair (``bridge.cfd.overset.OversetPair``): one ``KOmegaSST`` per grid,
+    coupled as the velocity is, by cells whose k and omega come from the other grid.
+
+    * Background: the cells whose centres lie in the hole (the body grid's rectangle less ``overlap``
+      background cells, where the background's faces take the body grid's velocity) are held at the body
+      grid's k and omega of the step's start (bilinear; one step behind, as the background steps first).
+      The background's wall distance counts the body at its starting pose (off by the motion's amplitude,
+      far from the wall: it only enters the blending functions there).
+    * Body grid: its outer ``ring`` cells (two: the advection stencil's reach) are held at the
+      background's k and omega of the step's end, at the cells' places at that time. The ring lies
+      ``overlap`` background cells outside the hole, so those values are the background's own solution.
+    k and omega are the same in either frame (scalars); the body grid advects them relative to itself
+    (``TransportedScalar``: the grid's velocity). Holding is the walls' mechanism (``KOmegaSST.hold``), so
+    positivity and the stage scheme are untouched; bilinear interpolation keeps the values positive."""
+
+    def __init__(self, pair, k_inf: float, omega_inf: float, body_walls: str = "function", ring: int = 2):
+        self.pair = pair
+        pose0 = pair.motion.pose(pair.t)
+        polygons = [b.polygon for b in pair.body.bodies]
+        self.background = KOmegaSST(pair.background, k_inf, omega_inf, body_walls,
+                                    far_walls=[(p, pose0) for p in polygons])
+        self.body = KOmegaSST(pair.body, k_inf, omega_inf, body_walls)
+        g, gb = GHOST, pair.body.grid
+        j, i = np.meshgrid(np.arange(gb.ny), np.arange(gb.nx), indexing="ij")
+        edge = (i < ring) | (i >= gb.nx - ring) | (j < ring) | (j >= gb.ny - ring)
+        self._ring = (j[edge] + g, i[edge] + g)
+        self._ring_xy = (gb.x_centres[i[edge]], gb.y_centres[j[edge]])
+        pair.model = self
+
+    def _hole_cells(self, t: float):
+        """Background cells (storage J, I) whose centres lie in the hole at t, and their body coordinates."""
+        pair, g = self.pair, GHOST
+        grid, gb = pair.background.grid, pair.body.grid
+        cx = np.array([gb.x_faces[0], gb.x_faces[-1]])[[0, 1, 0, 1]]
+        cy = np.array([gb.y_faces[0], gb.y_faces[-1]])[[0, 0, 1, 1]]
+        X, Y = pair.to_background(cx, cy, t)
+        i = np.nonzero((grid.x_centres >= X.min()) & (grid.x_centres <= X.max()))[0]
+        j = np.nonzero((grid.y_centres >= Y.min()) & (grid.y_centres <= Y.max()))[0]
+        JJ, II = np.meshgrid(j, i, indexing="ij")
+        xi, eta = pair.to_body(grid.x_centres[II], grid.y_centres[JJ], t)
+        hx0, hx1, hy0, hy1 = pair.hole
+        inside = (xi >= hx0) & (xi <= hx1) & (eta >= hy0) & (eta <= hy1)
+        return (JJ[inside] + g, II[inside] + g), xi[inside], eta[inside]
+
+    def advance(self, dt: float) -> None:
+        """k and omega of both grids over the step just taken by both flows (``OversetPair.step``)."""
+        pair, g = self.pair, GHOST
+        t = pair.t
+        bg, body = self.background, self.body
+        gb = pair.body.grid
+        bg.update()
+        (J, I), xi, eta = self._hole_cells(t)
+        if J.size:
+            inner = (slice(g, g + gb.ny), slice(g, g + gb.nx))
+            bg.hold(J, I, *(_bilinear(s.q.numpy()[inner], gb.x_centres, gb.y_centres, xi, eta)
+                            for s in (body.k, body.omega)))
+        advance_pair(bg.k, bg.omega, dt)
+        body.update()
+        grid = pair.background.grid
+        X, Y = pair.to_background(*self._ring_xy, t)
+        inner = (slice(g, g + grid.ny), slice(g, g + grid.nx))
+        body.hold(*self._ring, *(_bilinear(s.q.numpy()[inner], grid.x_centres, grid.y_centres, X, Y)
+                                 for s in (bg.k, bg.omega)))
+        advance_pair(body.k, body.omega, dt)
+
+    def stable_dt(self) -> float:
+        return min(self.background.stable_dt(), self.body.stable_dt())
+
+    def state_arrays(self) -> dict:
+        return {f"{name}/sst_{key}": a for name, m in (("background", self.background), ("body", self.body))
+                for key, a in m.state_arrays().items()}
+
+    def restored(self) -> None:
+        self.background.restored()
+        self.body.restored()

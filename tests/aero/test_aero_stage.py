@@ -16,11 +16,13 @@ class Killed(Exception):
 
 
 @pytest.mark.parametrize("grid", ["single", pytest.param("overset", marks=pytest.mark.slow),
-                                  pytest.param("single-sst", marks=pytest.mark.slow)])
+                                  pytest.param("single-sst", marks=pytest.mark.slow),
+                                  pytest.param("overset-sst", marks=pytest.mark.slow)])
 def test_a_killed_case_resumes_from_its_checkpoint_and_ends_with_the_same_numbers(tmp_path, grid):
     """Bit for bit: the checkpoint holds all the state (overset: both grids and the body grid's stream
     function of the last two steps, which the hole extrapolates; SST: k, omega and the eddy viscosity
-    of the next step). Overset and SST ~20 s each (slow), the laminar single grid a few seconds."""
+    of the next step, on each grid). Overset and SST ~20 s each (slow), the laminar single grid a few
+    seconds."""
     from dataclasses import replace
 
     poly = _unit_polygon(Rectangle(10.0, 2.0))
