@@ -351,8 +351,11 @@ def sst_body_walls(phi: wp.array2d(dtype=wp.float64), ext: wp.array2d(dtype=wp.f
     R q_w, implicit sink R, R = SST_HOLD, so the stage gives q_w to round-off).
 
     Cells inside the body (phi <= 0): omega = 60 nu / (beta_1 (2 ext)^2) (Menter's wall value over a
-    cell's extent across the wall); k = 0 for a resolved wall (``function`` 0), or with the wall
-    function the mean k of the cell's fluid neighbours (k has no flux into the wall).
+    cell's extent across the wall) and k = 0 for a resolved wall (``function`` 0); with the wall
+    function, the cells next to the fluid take the means of their fluid neighbours' k and omega (no flux
+    of either into the wall, and the eddy viscosity of the wall's fluid cells, not k over Menter's
+    omega: at Re 1e8 that is 1e-2 omega_log, and the thousandfold nu_t inside the body set the time
+    step), the others k = 0 and Menter's omega.
     With the wall function (``function`` 1), fluid cells whose centre lies within a cell's extent of the
     wall (phi <= 2 ext): omega = sqrt(omega_vis^2 + omega_log^2), omega_vis = 6 nu / (beta_1 phi^2),
     omega_log = sqrt(k) / (beta*^(1/4) kappa phi) - the sublayer and log-layer solutions, blended - and
@@ -373,8 +376,10 @@ def sst_body_walls(phi: wp.array2d(dtype=wp.float64), ext: wp.array2d(dtype=wp.f
         e = ext[jb, ib]
         if ph <= zero:
             kt = zero
+            wt = wp.float64(15.0) * nu / (SST_BETA1 * e * e)
             if function != 0:
                 acc = wp.float64(0.0)
+                acc_w = wp.float64(0.0)
                 cnt = wp.float64(0.0)
                 for m in range(4):
                     di = int(0)  # noqa: UP018 (Warp dynamic variable)
@@ -390,12 +395,14 @@ def sst_body_walls(phi: wp.array2d(dtype=wp.float64), ext: wp.array2d(dtype=wp.f
                     if ib + di >= 0 and ib + di < ni and jb + dj >= 0 and jb + dj < nj:
                         if phi[jb + dj, ib + di] > zero:
                             acc += wp.max(k[J + dj, I + di], zero)
+                            acc_w += w[J + dj, I + di]
                             cnt += wp.float64(1.0)
                 if cnt > zero:
                     kt = acc / cnt
+                    wt = acc_w / cnt
             src_k[J, I] = SST_HOLD * kt
             snk_k[J, I] = SST_HOLD
-            src_w[J, I] = SST_HOLD * wp.float64(15.0) * nu / (SST_BETA1 * e * e)
+            src_w[J, I] = SST_HOLD * wt
             snk_w[J, I] = SST_HOLD
         elif function != 0 and ph <= wp.float64(2.0) * e:
             sk = wp.sqrt(wp.max(k[J, I], zero))

@@ -123,8 +123,9 @@ def test_the_sst_wall_cells_hold_omega_at_the_blended_wall_value_and_k_free_of_w
     """After one step of the model on the slab: fluid cells within a cell of the wall hold omega =
     sqrt(omega_vis^2 + omega_log^2) of their k and distance, take nu_t = k / omega, and produce k at
     the log layer's rate u_tau^2 beta*^(1/4) sqrt(k) / (kappa d) with u_tau of the profile; cells
-    inside hold the mean k of their fluid neighbours (no flux of k into the wall) with the wall
-    function, k = 0 for a resolved wall."""
+    inside next to the fluid hold the means of their fluid neighbours' k and omega with the wall
+    function (no flux into the wall, and not the thousandfold nu_t of k over Menter's omega), k = 0 for
+    a resolved wall."""
     from bridge.cfd.turbulence import KOmegaSST
 
     sim, body, _ = _slab_flow(nu=1e-6)   # the first fluid cells at y+ 35
@@ -132,6 +133,7 @@ def test_the_sst_wall_cells_hold_omega_at_the_blended_wall_value_and_k_free_of_w
     model = KOmegaSST(sim, 1e-3, 10.0, body_walls="function")
     model.advance(1e-4)   # a first step to give k some variation near the wall
     k0 = model.k.interior().copy()
+    w0 = model.omega.interior().copy()
     model.advance(1e-4)
     g, grid = GHOST, sim.grid
     yc = grid.y_centres
@@ -149,6 +151,8 @@ def test_the_sst_wall_cells_hold_omega_at_the_blended_wall_value_and_k_free_of_w
     production = 0.05 ** 2 * 0.09 ** 0.25 * np.sqrt(kk) / (0.41 * d)
     np.testing.assert_allclose(model.k.source.numpy()[g + first, g:g + grid.nx][cols], production, rtol=1e-4)
     np.testing.assert_allclose(k[first - 1, cols], k0[first, cols], rtol=1e-12)   # the solid row under it
+    np.testing.assert_allclose(w[first - 1, cols], w0[first, cols], rtol=1e-12)
+    assert np.all(w[first - 1, cols] > 0.1 * expect)   # Menter's value would be 1e-2 of it here
     assert np.all(np.isfinite(sim.nu.numpy()[g:g + grid.ny, g:g + grid.nx]))
     sim2, _, _ = _slab_flow(nu=1e-6)
     model2 = KOmegaSST(sim2, 1e-3, 10.0, body_walls="resolved")
