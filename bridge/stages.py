@@ -97,7 +97,7 @@ STAGES: dict[str, Stage] = {
                  ignores=("air", "flutter", "section", "modal")),
     # the deck's aerodynamics from forced-motion CFD: the section and the [aero] options only, so
     # bridges with one deck share it (the flutter stage reads it when [flutter] aerodynamics = "cfd")
-    "aero": Stage("bridge.aero.stage:run", (), ("bridge.aero", "bridge.cfd", "kernels.cfd"), shared=True,
+    "aero": Stage("bridge.aero.stage:run", (), ("bridge.aero", "bridge.cfd", "kernels"), shared=True,
                   uses=("deck_section", "aero")),
     "flutter": Stage("bridge.flutter.stage:run", ("fem", "aero"), ("bridge.flutter", "bridge.structure.plots")),
 }

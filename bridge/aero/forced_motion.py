@@ -297,7 +297,7 @@ def case_key(shape, case: ForcedCase, q: Quality) -> str:
     from bridge.cache import _code_digest
 
     blob = json.dumps({"verts": [np.round(p.vertices, 12).tolist() for p in _polygons(shape)], "case": asdict(case),
-                       "quality": asdict(q), "code": _code_digest(("bridge.cfd", "kernels.cfd",
+                       "quality": asdict(q), "code": _code_digest(("bridge.cfd", "kernels",
                                                                     "bridge.aero.forced_motion"))}, sort_keys=True)
     return hashlib.sha256(blob.encode()).hexdigest()
 

@@ -118,6 +118,21 @@ def test_a_checkpoint_of_other_solver_code_is_not_resumed(monkeypatch):
     before = case_key(poly, case, QUALITY["tiny"])
     monkeypatch.setattr(cache, "_code_digest", lambda modules: "edited")
     assert case_key(poly, case, QUALITY["tiny"]) != before
+    # and it covers every kernel module the CFD runs (the SST's kernels.transport once was not), as does
+    # the aero stage's cache key
+    import sys
+
+    import bridge.aero.forced_motion
+    import bridge.cfd.turbulence  # noqa: F401
+    from bridge.stages import STAGES
+
+    seen = []
+    monkeypatch.setattr(cache, "_code_digest", lambda modules: seen.extend(modules) or "x")
+    case_key(poly, case, QUALITY["tiny"])
+    used = [m for m in sys.modules if m.startswith("kernels.") and m != "kernels.fem"]
+    assert "kernels.transport" in used and "kernels.wall_law" in used
+    for covers in (seen, STAGES["aero"].code):
+        assert all(any(m == c or m.startswith(c + ".") for c in covers) for m in used), covers
 
 
 
