@@ -3,6 +3,7 @@
     python tools/bench_turbulence.py                  # 512 x 256 cells
     python tools/bench_turbulence.py --size 1024x512 --steps 20 --repeats 5
     python tools/bench_turbulence.py --body          # with a pitching and heaving immersed deck
+    python tools/bench_turbulence.py --overset       # the aero stage's Great Belt pair (quick), heaving
 
 Method: a channel (inflow, outflow, no-slip walls) in a developing state, a fixed dt; blocks of
 ``--steps`` steps timed alternately: (a) the laminar step (``Simulation.step``), (b) the same step
@@ -11,7 +12,10 @@ ghosts). The ratio (b)/(a) is the median over blocks in one run (the machine is 
 absolute times, are comparable across runs). Issue 17's target: at most 2x. ``--body``: a box section
 (1 x 0.1, the Great Belt's proportions) heaving and pitching in the middle of the channel, an immersed
 body in both (a) and (b); (b) then also pays the model's wall cells and wall function, with the body's
-box of exact distances refreshed every step (it moves).
+box of exact distances refreshed every step (it moves). ``--overset``: the aero stage's overset pair of the
+``quick`` preset with the Great Belt deck heaving (``bridge.aero.forced_motion``; ``--size`` does not
+apply); (a) the pair's step, (b) the same with ``OversetSST`` (both grids' models and the exchange of k
+and omega).
 """
 
 from __future__ import annotations
@@ -40,8 +44,11 @@ def main(argv=None) -> int:
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--json", type=Path, default=None)
     ap.add_argument("--body", action="store_true", help="an immersed section moving in the channel")
+    ap.add_argument("--overset", action="store_true", help="the Great Belt deck heaving on the quick overset pair")
     args = ap.parse_args(argv)
     wp.config.quiet = True
+    if args.overset:
+        return _overset(args)
     nx, ny = args.size
     nu = 1e-4
     grid = CartesianGrid.uniform(nx, ny, (0.0, 4.0), (0.0, 2.0))
@@ -82,6 +89,46 @@ def main(argv=None) -> int:
     if args.json:
         args.json.parent.mkdir(parents=True, exist_ok=True)
         args.json.write_text(json.dumps(row))
+    return 0
+
+
+def _overset(args) -> int:
+    """Blocks of the pair's step without and with its SST model (module doc)."""
+    from dataclasses import replace
+
+    from bridge.aero.forced_motion import ForcedCase, _overset_flow, preset
+    from bridge.aero.stage import _unit_polygons
+    from bridge.cfd.sections import great_belt_section
+
+    q = replace(preset("quick", "overset"), turbulence="sst", reynolds=1.05e8)
+    pair = _overset_flow(q, _unit_polygons(great_belt_section()), ForcedCase.thesis("heave", 0.5), None)
+    model = pair.model
+    dt = pair.stable_dt()
+    for _ in range(20):
+        pair.step(dt)
+    flow, both = [], []
+    for _ in range(args.repeats):
+        pair.model = None
+        t0 = time.perf_counter()
+        for _ in range(args.steps):
+            pair.step(dt)
+        flow.append((time.perf_counter() - t0) / args.steps)
+        pair.model = model
+        t0 = time.perf_counter()
+        for _ in range(args.steps):
+            pair.step(dt)
+        both.append((time.perf_counter() - t0) / args.steps)
+    cells = pair.n_cells
+    ratio = float(np.median(np.array(both) / np.array(flow)))
+    tf, tb = float(np.median(flow)), float(np.median(both))
+    print(f"{pair.describe()} = {cells} cells, the Great Belt deck heaving (quick overset pair)")
+    for label, sec in (("pair step", tf), ("step + SST", tb)):
+        print(f"  {label:<13} {1e3 * sec:.2f} ms/step  {cells / sec / 1e6:.2f} M cell-steps/s")
+    print(f"  SST cost factor {ratio:.2f} (median of {args.repeats} block ratios; target <= 2)")
+    if args.json:
+        args.json.parent.mkdir(parents=True, exist_ok=True)
+        args.json.write_text(json.dumps({"overset": True, "cells": cells, "laminar_ms_per_step": 1e3 * tf,
+                                         "sst_ms_per_step": 1e3 * tb, "ratio": ratio}))
     return 0
 
 

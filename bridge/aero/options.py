@@ -14,13 +14,14 @@ Keys (all optional):
                           heave and one pitch run moving at all of them at once (a sum of sines,
                           bridge.aero.forced_motion.ForcedCase.multi_frequency); the reduced velocities must
                           then be the largest one over whole numbers (e.g. 16, 8, 5.333, 4)
-    grid                  "single": one grid, the section an immersed body moving on it (default); "overset":
-                          the section in a fine grid that moves with it over a coarser fixed background
-                          (bridge/cfd/overset.py; no face of the body changes class as it moves)
-    turbulence            "laminar": the preset's low Reynolds number, no turbulence model (default); "sst": the
-                          k-omega SST model (2003 variant) with Spalding's wall function on the section, at the
-                          deck's Reynolds number Re = wind_speed_m_s B / nu_air ([air] kinematic viscosity);
-                          on either grid (bridge/cfd/turbulence.py, docs/cfd.md)
+    grid                  "overset" (default): the section in a fine grid that moves with it over a coarser
+                          fixed background (bridge/cfd/overset.py; no face of the body changes class as it
+                          moves); "single": one grid, the section an immersed body moving on it (with "sst"
+                          its forces jitter as the faces change class: docs/aero.md)
+    turbulence            "sst" (default): the k-omega SST model (2003 variant) with Spalding's wall function on
+                          the section, at the deck's Reynolds number Re = wind_speed_m_s B / nu_air ([air]
+                          kinematic viscosity), on either grid (bridge/cfd/turbulence.py, docs/cfd.md);
+                          "laminar": the preset's low Reynolds number, no turbulence model
     wind_speed_m_s        the wind speed that sets the Reynolds number with turbulence = "sst" (default the
                           thesis's 50 m/s: Re = 1.05e8 for the Great Belt's 31 m); the derivatives are
                           per unit wind speed either way
@@ -52,8 +53,8 @@ class AeroOptions:
     checkpoint_every: int = 2000
     static_angles_deg: tuple[float, ...] = (-2.0, 0.0, 2.0)
     excitation: str = "single"
-    grid: str = "single"
-    turbulence: str = "laminar"
+    grid: str = "overset"
+    turbulence: str = "sst"
     wind_speed_m_s: float = 50.0
 
     def __post_init__(self):
