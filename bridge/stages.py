@@ -89,6 +89,10 @@ class Stage:
 # The scenario fields that never change a result: how it is called and where it was read from.
 IDENTITY_FIELDS = ("description", "source_path")
 
+# The kernel modules the CFD runs (a test checks that the list is complete): part of the aero stage's key
+# and of each CFD case's checkpoint key (bridge.aero.forced_motion.case_key).
+CFD_KERNELS = ("kernels.cfd", "kernels.transport", "kernels.wall_law")
+
 # Registry; the order here is the run order.
 STAGES: dict[str, Stage] = {
     "cable": Stage("bridge.cable_stage:run", (), ("bridge.cable", "bridge.cable_stage"),
@@ -97,7 +101,7 @@ STAGES: dict[str, Stage] = {
                  ignores=("air", "flutter", "section", "modal")),
     # the deck's aerodynamics from forced-motion CFD: the section and the [aero] options only, so
     # bridges with one deck share it (the flutter stage reads it when [flutter] aerodynamics = "cfd")
-    "aero": Stage("bridge.aero.stage:run", (), ("bridge.aero", "bridge.cfd", "kernels"), shared=True,
+    "aero": Stage("bridge.aero.stage:run", (), ("bridge.aero", "bridge.cfd", *CFD_KERNELS), shared=True,
                   uses=("deck_section", "aero")),
     "flutter": Stage("bridge.flutter.stage:run", ("fem", "aero"), ("bridge.flutter", "bridge.structure.plots")),
 }

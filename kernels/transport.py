@@ -395,11 +395,12 @@ def sst_body_walls(phi: wp.array2d(dtype=wp.float64), ext: wp.array2d(dtype=wp.f
                     if ib + di >= 0 and ib + di < ni and jb + dj >= 0 and jb + dj < nj:
                         if phi[jb + dj, ib + di] > zero:
                             acc += wp.max(k[J + dj, I + di], zero)
-                            acc_w += w[J + dj, I + di]
+                            acc_w += wp.max(w[J + dj, I + di], zero)
                             cnt += wp.float64(1.0)
                 if cnt > zero:
                     kt = acc / cnt
-                    wt = acc_w / cnt
+                    if acc_w > zero:
+                        wt = acc_w / cnt
             src_k[J, I] = SST_HOLD * kt
             snk_k[J, I] = SST_HOLD
             src_w[J, I] = SST_HOLD * wt

@@ -295,9 +295,10 @@ def case_key(shape, case: ForcedCase, q: Quality) -> str:
     """What a checkpoint must match to be resumed: the geometry, the case, the preset and the source of
     the solver (a changed CFD code never resumes an old run)."""
     from bridge.cache import _code_digest
+    from bridge.stages import CFD_KERNELS
 
     blob = json.dumps({"verts": [np.round(p.vertices, 12).tolist() for p in _polygons(shape)], "case": asdict(case),
-                       "quality": asdict(q), "code": _code_digest(("bridge.cfd", "kernels",
+                       "quality": asdict(q), "code": _code_digest(("bridge.cfd", *CFD_KERNELS,
                                                                     "bridge.aero.forced_motion"))}, sort_keys=True)
     return hashlib.sha256(blob.encode()).hexdigest()
 
