@@ -145,6 +145,36 @@ def test_the_overset_grids_hold_each_others_k_and_omega():
     assert model.body.k.q.numpy()[model._ring].max() > 1.5 * K0   # the blob is at the ring: not trivially uniform
 
 
+def test_an_overset_body_has_its_walls_in_both_grids_and_the_hole_is_the_cells_inside_it():
+    """With a box section on the pair: the background's wall distance counts the body (its far wall), the
+    body grid's body takes the wall function, a few steps keep k and omega positive and finite on both
+    grids, and the held hole cells are exactly the background cells whose centres lie in the hole (a
+    brute-force check over every cell)."""
+    from bridge.cfd import box_deck
+
+    cfg = FlowConfig(nu=1e-6, bc=BoundaryConditions(u_inf=1.0))
+    pair = OversetPair(BACKGROUND, BODY_GRID, cfg, HarmonicMotion(0.0, 0.0, (0.0, 0.1, 0.05), omega=2.0),
+                       polygon=box_deck(1.0, 0.1))
+    pair.set_uniform_flow(1.0)
+    model = OversetSST(pair, *freestream_turbulence(1.0, 1e-6))
+    d = model.background.wall_distance
+    j, i = np.searchsorted(BACKGROUND.y_centres, 0.3), np.searchsorted(BACKGROUND.x_centres, 0.0)
+    assert abs(d[j, i] - (BACKGROUND.y_centres[j] - 0.05)) < 0.02      # above the box's top (0.05)
+    assert pair.body.bodies[0].wall_law == 1e-6
+    for _ in range(10):
+        pair.step(0.01)
+    for m in (model.background, model.body):
+        for s in (m.k, m.omega):
+            q = s.interior()
+            assert np.all(np.isfinite(q)) and q.min() > 0
+    (J, I), _, _ = model._hole_cells(pair.t)
+    X, Y = np.meshgrid(BACKGROUND.x_centres, BACKGROUND.y_centres)
+    xi, eta = pair.to_body(X, Y, pair.t)
+    hx0, hx1, hy0, hy1 = pair.hole
+    want = np.nonzero((xi >= hx0) & (xi <= hx1) & (eta >= hy0) & (eta <= hy1))
+    assert sorted(zip(J - GHOST, I - GHOST, strict=True)) == sorted(zip(*want, strict=True))
+
+
 @pytest.mark.slow  # ~30 s: runs in CI with -m slow
 def test_channel_at_re_tau_395_follows_the_law_of_the_wall():
     """Fully developed channel, Re_tau 395 (tools/validate_turbulence.py channel): the wall shear balances
