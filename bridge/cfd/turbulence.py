@@ -165,9 +165,7 @@ class KOmegaSST:
                        [b["phi"], b["ext"], b["i0"], b["j0"], b["ni"], k.q, w.q, sim.u, sim.v, float(grid.x_faces[0]),
                         grid.dx, self._yc, g, wp.vec3d(*b["pose"]), vel, self.nu, int(self.body_walls == "function"),
                         k.source, k.sink, w.source, w.sink, sim.nu, k.gamma, w.gamma])
-        nu = sim.nu.numpy()[g:g + grid.ny, g:g + grid.nx]
-        sim.nu_rows = nu.max(axis=1)
-        sim.nu_max = float(sim.nu_rows.max())
+        self.restored()
 
     def stable_dt(self) -> float:
         """The transport's limit for k and omega, from each row's largest diffusivity and the largest
@@ -197,7 +195,8 @@ class KOmegaSST:
                 "omega_gamma": self.omega.gamma}
 
     def restored(self) -> None:
-        """After ``state_arrays`` were assigned: the flow's viscous time-step limit from nu + nu_t."""
+        """The flow's viscous time-step limit from its nu + nu_t (after ``update``, and after
+        ``state_arrays`` were assigned)."""
         g, grid = GHOST, self.sim.grid
         rows = self.sim.nu.numpy()[g:g + grid.ny, g:g + grid.nx].max(axis=1)
         self.sim.nu_rows, self.sim.nu_max = rows, float(rows.max())
@@ -280,22 +279,20 @@ class OversetSST:
 
     def advance(self, dt: float) -> None:
         """k and omega of both grids over the step just taken by both flows (``OversetPair.step``)."""
-        pair, g = self.pair, GHOST
+        pair = self.pair
         t = pair.t
         bg, body = self.background, self.body
         gb = pair.body.grid
         bg.update()
         (J, I), xi, eta = self._hole_cells(t)
         if J.size:
-            inner = (slice(g, g + gb.ny), slice(g, g + gb.nx))
-            bg.hold(J, I, *(_bilinear(s.q.numpy()[inner], gb.x_centres, gb.y_centres, xi, eta)
+            bg.hold(J, I, *(_bilinear(s.interior(), gb.x_centres, gb.y_centres, xi, eta)
                             for s in (body.k, body.omega)))
         advance_pair(bg.k, bg.omega, dt)
         body.update()
         grid = pair.background.grid
         X, Y = pair.to_background(*self._ring_xy, t)
-        inner = (slice(g, g + grid.ny), slice(g, g + grid.nx))
-        body.hold(*self._ring, *(_bilinear(s.q.numpy()[inner], grid.x_centres, grid.y_centres, X, Y)
+        body.hold(*self._ring, *(_bilinear(s.interior(), grid.x_centres, grid.y_centres, X, Y)
                                  for s in (bg.k, bg.omega)))
         advance_pair(body.k, body.omega, dt)
 
