@@ -471,11 +471,41 @@ def face_gradient(p: wp.array2d(dtype=wp.float64), hy_f: wp.array(dtype=wp.float
     return (p[J, I] - p[J - 1, I]) / hy_f[J]
 
 
+@wp.func
+def square_to_wall(x: wp.float64, y: wp.float64, pos: wp.vec3d, verts: wp.array(dtype=wp.vec2d), di: int, dj: int):
+    """Whether the grid line (di, dj) through the face at (x, y) runs within 45 degrees of the wall's normal
+    there: the direction from the face's nearest point on the moved polygon to the face (the gradient of
+    the distance; at a corner the direction from the corner)."""
+    c = wp.cos(pos[2])
+    s = wp.sin(pos[2])
+    X = x - pos[0]
+    Y = y - pos[1]
+    bx = c * X + s * Y
+    by = -s * X + c * Y
+    near = polygon_nearest(bx, by, verts)
+    n = verts.shape[0]
+    k = int(near[1])
+    a = verts[k]
+    b = verts[(k + 1) % n]
+    t = near[2]
+    nx = bx - (a[0] + t * (b[0] - a[0]))
+    ny = by - (a[1] + t * (b[1] - a[1]))
+    length = wp.sqrt(nx * nx + ny * ny)
+    ok = False
+    if length > wp.float64(0.0):
+        # the normal in the grid frame, and its component along the line
+        gx = c * nx - s * ny
+        gy = s * nx + c * ny
+        ok = wp.abs(gx * wp.float64(di) + gy * wp.float64(dj)) > wp.float64(0.7071067811865476) * length
+    return ok
+
+
 @wp.kernel
 def ib_targets(q: wp.array2d(dtype=wp.float64), phi: wp.array2d(dtype=wp.float64),
                x0: wp.float64, dx: wp.float64, xoff: wp.float64, yc: wp.array(dtype=wp.float64),
                pos: wp.vec3d, vel: wp.vec3d, comp: int, i0: int, j0: int, ni: int,
                ilo: int, ihi: int, jlo: int, jhi: int, order: int, wall_law: int, nu: wp.float64,
+               verts: wp.array(dtype=wp.vec2d),
                target: wp.array2d(dtype=wp.float64), state: wp.array2d(dtype=wp.int32)):
     """Direct-forcing target of each face in the box (state: 0 fluid, 1 solid, 2 interface).
 
@@ -488,9 +518,13 @@ def ib_targets(q: wp.array2d(dtype=wp.float64), phi: wp.array2d(dtype=wp.float64
     line (u on a vertical line, v on a horizontal one), q_f = q_b + (q_o - q_b) r with r = u(phi_f) /
     u(phi_o) on Spalding's law of the wall through q_o (``kernels.wall_law``; phi: the faces' distances
     to the wall, u_tau from |q_o - q_b| and the molecular ``nu``; r = phi_f / phi_o, the linear profile,
-    when the reference face lies in the viscous sublayer). The component along the line, which meets
+    when the reference face lies in the viscous sublayer), on lines that meet the wall nearly square
+    (within 45 degrees of its normal, ``square_to_wall``). The component along the line, which meets
     the wall, keeps the straight line: the law of the wall is a tangential profile, and applied to the
-    normal velocity of a moving deck it made its heave damping change sign (docs/aero.md).
+    normal velocity of a moving deck it made its heave damping change sign (docs/aero.md). So does the
+    component across a line that meets an inclined wall obliquely: there it is mostly the normal
+    velocity (v on a horizontal line against the deck's 28-degree bottom panels), and the wall law on it
+    let the flow through the wall at the trailing edge until the run diverged (docs/aero.md).
     Only faces with ilo <= I < ihi and jlo <= J < jhi are updated (boundary faces excluded);
     reads ``q`` and writes ``target``/``state`` only, so the result does not depend on order.
     """
@@ -553,7 +587,8 @@ def ib_targets(q: wp.array2d(dtype=wp.float64), phi: wp.array2d(dtype=wp.float64
                             # square); the component along the line, towards the wall, keeps the straight line
                             tangential = (comp == 0 and dj != 0) or (comp == 1 and di != 0)
                             if wall_law != 0 and po > ph and tangential:
-                                r = wall_law_ratio(wp.abs(qo - qb), po, ph, nu)
+                                if square_to_wall(x, y, pos, verts, di, dj):
+                                    r = wall_law_ratio(wp.abs(qo - qb), po, ph, nu)
                             acc += qb + (qo - qb) * r
                         cnt += wp.float64(1.0)
                 if cnt > wp.float64(0.0):

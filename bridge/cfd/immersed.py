@@ -165,7 +165,7 @@ class ImmersedBody:
                                                  self.pos, self.vel, comp, b["i0"], b["j0"], b["ni"],
                                                  ilo, ihi, jlo, jhi, self.order, int(self.wall_law is not None),
                                                  0.0 if self.wall_law is None else float(self.wall_law),
-                                                 b["target"], b["state"]])
+                                                 self.verts, b["target"], b["state"]])
         self._close_targets()
         for comp, q in ((0, u), (1, v)):
             b = self.boxes[comp]

@@ -10,6 +10,7 @@ import warp as wp
 
 from bridge.cfd.grids import GHOST
 from kernels import wall_law as wl
+from kernels.cfd import square_to_wall
 
 KAPPA, B = 0.41, 5.0
 
@@ -173,3 +174,46 @@ def test_the_wall_function_refuses_what_it_cannot_do():
         body.set_wall_function(0.0)
     with pytest.raises(ValueError, match="body_walls: one of function, resolved"):
         KOmegaSST(sim, 1e-3, 10.0, body_walls="log")
+
+
+# --- which grid lines take the wall function (kernels.cfd.square_to_wall) ---------------------------
+
+@wp.kernel
+def _square(px: wp.array(dtype=wp.float64), py: wp.array(dtype=wp.float64), pos: wp.vec3d,
+            verts: wp.array(dtype=wp.vec2d), horizontal: wp.array(dtype=wp.float64),
+            vertical: wp.array(dtype=wp.float64)):
+    i = wp.tid()
+    horizontal[i] = wp.float64(0.0)
+    vertical[i] = wp.float64(0.0)
+    if square_to_wall(px[i], py[i], pos, verts, 1, 0):
+        horizontal[i] = wp.float64(1.0)
+    if square_to_wall(px[i], py[i], pos, verts, 0, 1):
+        vertical[i] = wp.float64(1.0)
+
+
+def _lines_square(verts, points, pose=(0.0, 0.0, 0.0)):
+    pts = np.asarray(points, float)
+    v = wp.array(np.asarray(verts, float), dtype=wp.vec2d, device="cpu")
+    h, vv = _run(_square, len(pts), [pts[:, 0], pts[:, 1], wp.vec3d(*pose), v], 2)
+    return h.astype(bool), vv.astype(bool)
+
+
+def test_the_wall_function_takes_only_lines_that_meet_the_wall_nearly_square():
+    """A wedge like the deck's trailing edge (panels at about 28 degrees to x): a vertical line meets a
+    panel within 45 degrees of its normal, a horizontal one does not (there the component across the line
+    is mostly the normal velocity, and the wall law on it diverged at the trailing edge, docs/aero.md). Past
+    the tip the normal is the direction from the corner. A quarter turn of the body swaps the two lines."""
+    wedge = [[0.0, -0.1], [0.2, 0.0], [0.0, 0.1]]        # tip at (0.2, 0), panels at 26.6 degrees
+    points = [[0.1, 0.06],     # above the upper panel (normal 63.4 degrees from x)
+              [0.1, -0.06],    # below the lower one
+              [0.3, 0.01],     # past the tip, nearly on the line of symmetry: the corner's direction is ~x
+              [0.22, 0.05]]    # past the tip, steeply above it: the corner's direction is ~68 degrees from x
+    h, v = _lines_square(wedge, points)
+    np.testing.assert_array_equal(h, [False, False, True, False])
+    np.testing.assert_array_equal(v, [True, True, False, True])
+    # the body turned by 90 degrees (pose theta) with the points turned with it: the roles swap
+    c, s = 0.0, 1.0
+    turned = [[c * x - s * y, s * x + c * y] for x, y in points]
+    h2, v2 = _lines_square(wedge, turned, pose=(0.0, 0.0, np.pi / 2))
+    np.testing.assert_array_equal(h2, v)
+    np.testing.assert_array_equal(v2, h)
