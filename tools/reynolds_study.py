@@ -45,10 +45,12 @@ THESIS_TABLE_5_3 = {25.0: {"H_pu": 1.95e3, "H_mu": 1.66e4, "H_ptheta": 3.95e4, "
 
 
 def run_speed(speed: float, omega: float, quality: str, turbulence: str, runs: Path | None, say=print,
-              grid: str = "overset") -> dict:
+              grid: str = "overset", **changes) -> dict:
+    """Heave and pitch at one speed; ``changes``: fields of the preset to replace (a grid study's
+    cells_per_chord, cfl)."""
     section = great_belt_section()
     polys = _unit_polygons(section)
-    q = preset(quality, grid)
+    q = replace(preset(quality, grid), **changes)
     if turbulence != "laminar":
         q = replace(q, turbulence=turbulence, reynolds=speed * section.chord_m / NU_AIR)
     row: dict = {"speed_m_s": speed, "reynolds": q.reynolds, "turbulence": q.turbulence, "quality": quality,
