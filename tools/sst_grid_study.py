@@ -121,14 +121,15 @@ def main(argv=None) -> int:
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
     runs = out.with_name(out.stem + "_runs")
-    rows = [run_resolution(c, args, runs) for c in sorted(args.cells)]
-    text = table(rows, args.angles)
+    command = "python tools/sst_grid_study.py " + " ".join(argv if argv is not None else sys.argv[1:])
+    rows = []
+    for c in sorted(args.cells):   # the file holds every finished resolution, so a long study shows as it goes
+        rows.append(run_resolution(c, args, runs))
+        text = table(rows, args.angles)
+        tmp = out.with_suffix(".tmp")
+        tmp.write_text(json.dumps({"command": command, "rows": rows, "table": text}, indent=1))
+        tmp.replace(out)
     print(text)
-    result = {"command": "python tools/sst_grid_study.py " + " ".join(argv if argv is not None else sys.argv[1:]),
-              "rows": rows, "table": text}
-    tmp = out.with_suffix(".tmp")
-    tmp.write_text(json.dumps(result, indent=1))
-    tmp.replace(out)
     return 0
 
 
