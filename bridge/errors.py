@@ -18,6 +18,9 @@ class InputError(ValueError):
         self.key, self.value, self.allowed = key, value, allowed
         super().__init__(f"{key} = {value!r}: {allowed}")
 
+    def __reduce__(self):   # picklable, so that a worker process can raise it (the aero stage's cases)
+        return type(self), (self.key, self.value, self.allowed)
+
 
 class ConvergenceError(RuntimeError):
     """An iteration that did not converge; the message carries the last residual."""
@@ -29,13 +32,20 @@ class ConvergenceError(RuntimeError):
             f"(tolerance {tolerance:.1e})"
         )
 
+    def __reduce__(self):
+        return type(self), (self.what, self.iterations, self.residual, self.tolerance)
+
 
 class DivergedError(ConvergenceError):
     """A time-marching solution that stopped being finite (the CFD): ``what`` and where/when."""
 
     def __init__(self, what: str, detail: str):
         self.what, self.iterations, self.residual, self.tolerance = what, 0, float("inf"), 0.0
+        self.detail = detail
         RuntimeError.__init__(self, f"{what} diverged: {detail}")
+
+    def __reduce__(self):
+        return type(self), (self.what, self.detail)
 
 
 def check_range(key: str, value: float, low: float | None = None, high: float | None = None,

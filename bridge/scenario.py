@@ -120,6 +120,9 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--quality", choices=("tiny", "quick", "standard", "fine"), default=None,
                    help="CFD preset of the aero stage (grid, time step, Reynolds number; docs/aero.md); "
                         "default: the scenario's [aero] quality, tiny with --quick")
+    p.add_argument("--workers", type=int, default=None, metavar="N",
+                   help="processes running the aero stage's CFD cases side by side (default: 2 on a machine "
+                        "with 2 or more cores; 1: one after the other)")
     p.add_argument("--quiet", action="store_true", help="no progress messages")
     p.add_argument("--version", action="version", version=f"bridge-flutter {__version__}")
     return p
@@ -159,6 +162,8 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 def _run(args: argparse.Namespace, say, written: list[Path]) -> int:
     stages = parse_stages(args.stages)
+    if args.workers is not None and not 1 <= args.workers <= 64:
+        raise InputError("--workers", args.workers, "allowed: 1 .. 64 processes")
     # read and check everything before running anything, so bad input costs nothing
     scenarios = [load_scenario(n, main_span_m=args.main_span) for n in args.scenarios]
     seen: dict[str, str] = {}
@@ -176,7 +181,7 @@ def _run(args: argparse.Namespace, say, written: list[Path]) -> int:
         raise InputError("--out", str(comparison), "already holds a comparison of an earlier run; pass "
                          "--overwrite to replace it or choose another --out")
     options = RunOptions(quick=args.quick, progress=say, cache=None if args.no_cache else args.out / ".cache",
-                         quality=args.quality)
+                         quality=args.quality, workers=args.workers)
     summaries = {}
     for sc in scenarios:
         t0 = time.perf_counter()

@@ -48,12 +48,15 @@ class RunOptions:
     """Options of one run that are not physics: ``quick`` shrinks meshes/grids for tests and smoke runs;
     ``progress`` is a callable taking a one-line message (default: none); ``cache`` is the folder of the
     stage cache (:mod:`bridge.cache`; None: compute every stage afresh and keep nothing);
-    ``quality`` the CFD preset of the aero stage (None: the scenario's, "tiny" with ``quick``)."""
+    ``quality`` the CFD preset of the aero stage (None: the scenario's, "tiny" with ``quick``); ``workers``
+    the processes that run the aero stage's CFD cases side by side (None: 2 on a machine with 2 or more
+    cores, :func:`bridge.aero.forced_motion.default_workers`; 1: one after the other, each on all cores)."""
 
     quick: bool = False
     progress: Callable[[str], None] | None = None
     cache: Path | None = None
     quality: str | None = None
+    workers: int | None = None
 
     def say(self, message: str) -> None:
         if self.progress is not None:

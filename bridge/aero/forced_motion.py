@@ -26,6 +26,7 @@ import hashlib
 import json
 import math
 import os
+import signal
 import tempfile
 import time
 from collections.abc import Callable
@@ -37,7 +38,7 @@ import numpy as np
 from bridge.errors import DivergedError, InputError, check_range
 
 __all__ = ["Quality", "QUALITY", "ForcedCase", "StaticCase", "ForceRecord", "run_case", "case_key",
-           "checkpoint_path", "whole_periods", "preset", "GRIDS", "TURBULENCE",
+           "checkpoint_path", "whole_periods", "run_cases", "default_workers", "preset", "GRIDS", "TURBULENCE",
            "THESIS_HEAVE_RATE", "THESIS_PITCH_RATE"]
 
 TURBULENCE = ("laminar", "sst")
@@ -370,6 +371,98 @@ def run_case(shape, case: ForcedCase | StaticCase, quality: Quality, checkpoint:
         return _march(flow, polys, case, q, checkpoint, checkpoint_every, progress, label)
     except FlowDiverged as err:
         raise DivergedError(f"the CFD of {label or case}", str(err)) from None
+
+
+def default_workers() -> int:
+    """Cases run side by side: two on a machine with two or more cores, one inside a process that is itself
+    a worker (a sweep's case, or a case of :func:`run_cases`), so that nothing runs more processes than cores."""
+    import multiprocessing
+
+    return 2 if (os.cpu_count() or 1) >= 2 and multiprocessing.parent_process() is None else 1
+
+
+_PROGRESS = None   # in a case worker: the queue its progress lines go to
+_STOPPING = None   # in a case worker: set by the parent on Ctrl-C or a failed case
+
+
+def _case_worker_start(queue, stopping) -> None:
+    """Case workers leave Ctrl-C to the parent, which sets ``stopping`` and forwards it to the running cases
+    (run_cases)."""
+    global _PROGRESS, _STOPPING
+    _PROGRESS, _STOPPING = queue, stopping
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+def _case_in_worker(shape, case, quality, checkpoint, checkpoint_every, label) -> ForceRecord:
+    signal.signal(signal.SIGINT, signal.default_int_handler)   # a forwarded Ctrl-C stops the case cleanly
+    try:
+        if _STOPPING is not None and _STOPPING.is_set():
+            raise KeyboardInterrupt   # handed to this worker before the stop, which cancel() cannot take back
+        return run_case(shape, case, quality, checkpoint, checkpoint_every, threads=1,
+                        progress=None if _PROGRESS is None else _PROGRESS.put, label=label)
+    finally:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+def run_cases(shape, jobs, quality: Quality, checkpoint_every: int = 2000,
+              progress: Callable[[str], None] | None = None, workers: int | None = None) -> list[ForceRecord]:
+    """:func:`run_case` for every ``(case, checkpoint, label)`` of ``jobs``; the records in the jobs' order.
+
+    With ``workers`` > 1 (default :func:`default_workers`) the cases run side by side in that many
+    processes, each on one core: on this project's 2-core machine two cases at once finish sooner than the
+    same cases one after the other on two threads each (docs/performance.md, "The aero stage").  Their
+    progress lines reach ``progress`` from here.  A case that fails stops the others (each keeps its last
+    checkpoint) and its error is raised here; so is Ctrl-C, which the running cases receive too."""
+    import multiprocessing
+    import queue as queues
+    from concurrent.futures import FIRST_EXCEPTION, ProcessPoolExecutor, wait
+
+    workers = default_workers() if workers is None else workers
+    if workers <= 1 or len(jobs) < 2:
+        return [run_case(shape, case, quality, ckpt, checkpoint_every, progress=progress, label=label)
+                for case, ckpt, label in jobs]
+
+    context = multiprocessing.get_context("spawn")   # fresh processes: no copy of this one's Warp threads
+    lines, stopping = context.Queue(), context.Event()
+
+    def drain() -> None:
+        while True:
+            try:
+                line = lines.get_nowait()
+            except queues.Empty:
+                return
+            if progress is not None:
+                progress(line)
+
+    pool = ProcessPoolExecutor(max_workers=min(workers, len(jobs)), mp_context=context,
+                               initializer=_case_worker_start, initargs=(lines, stopping))
+    futures = []
+    try:
+        futures = [pool.submit(_case_in_worker, shape, case, quality, ckpt, checkpoint_every, label)
+                   for case, ckpt, label in jobs]
+        pending = set(futures)
+        while pending:
+            done, pending = wait(pending, timeout=0.5, return_when=FIRST_EXCEPTION)
+            drain()
+            for f in done:
+                f.result()   # a failed case: raise its error now (the handler below stops the others)
+        drain()
+        records = [f.result() for f in futures]
+    except BaseException:
+        stopping.set()
+        for f in futures:
+            f.cancel()
+        for child in list(getattr(pool, "_processes", {}).values()):   # the running cases stop cleanly
+            if child.pid is not None and child.is_alive():
+                try:
+                    os.kill(child.pid, signal.SIGINT)
+                except OSError:
+                    pass
+        pool.shutdown(wait=True, cancel_futures=True)
+        drain()
+        raise
+    pool.shutdown(wait=True)
+    return records
 
 
 def _march(flow, polys, case, q, checkpoint, checkpoint_every, progress, label) -> ForceRecord:

@@ -29,7 +29,7 @@ from bridge.aero.forced_motion import (
     StaticCase,
     checkpoint_path,
     preset,
-    run_case,
+    run_cases,
     whole_periods,
 )
 from bridge.aero.frequency_response import forced_motion_response
@@ -118,12 +118,20 @@ def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
     errors = {n: np.zeros(len(Ks), dtype=complex) for n in values}
     records, cells, grids = [], 0, ""
     cases = _forced_cases(Ks, aopts)
+    jobs = []
     for n, case in enumerate(cases):
+        what = ", ".join(f"{2 * np.pi / k:.3g}" for k in case.reduced_frequencies)
+        jobs.append((case, checkpoint_path(runs, poly, case, q),
+                     f"aero case {n + 1}/{len(cases)}, {case.dof} U/(fB) = {what}"))
+    angles = aopts.static_angles_deg
+    for n, angle in enumerate(angles):
+        case = StaticCase(angle, grid_angle_deg=max(abs(a) for a in angles))
+        jobs.append((case, checkpoint_path(runs, poly, case, q),
+                     f"aero static {n + 1}/{len(angles)}, angle {angle:g} deg"))
+    # all cases at once, side by side on the cores where that pays (bridge.aero.forced_motion.run_cases)
+    done = run_cases(poly, jobs, q, aopts.checkpoint_every, progress=options.say, workers=options.workers)
+    for case, rec in zip(cases, done[:len(cases)], strict=True):
         ks = case.reduced_frequencies
-        what = ", ".join(f"{2 * np.pi / k:.3g}" for k in ks)
-        label = f"aero case {n + 1}/{len(cases)}, {case.dof} U/(fB) = {what}"
-        rec = run_case(poly, case, q, checkpoint_path(runs, poly, case, q), aopts.checkpoint_every,
-                       progress=options.say, label=label)
         sel = whole_periods(rec, case, q)
         # a multi-frequency run's drag is no FRF: drag is quadratic in the motion, and twice one frequency is
         # another of the set (h_qu, h_qtheta then come from the static runs' quasi-steady model)
@@ -148,7 +156,7 @@ def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
         for r in same:
             if r is not same[len(same) // 2]:
                 r["snapshot"] = None
-    static, static_records = _static_runs(poly, section, aopts, q, runs, options)
+    static, static_records = _static_results(done[len(cases):], section, aopts, options)
     frf, stderr = FRF(**values), FRF(**errors)
     measured = VERTICAL_TORSIONAL + (("h_qu", "h_qtheta") if aopts.excitation == "single" else ())
     table = DerivativeTable(Ks, derivatives_from_frf(Ks, frf), source=f"cfd ({section.name}, {quality})",
@@ -174,21 +182,15 @@ def _forced_cases(Ks: np.ndarray, aopts: AeroOptions) -> list[ForcedCase]:
     return [ForcedCase(dof, (float(K),), (rate / float(K),)) for K in Ks for dof, rate in rates]
 
 
-def _static_runs(poly, section, aopts: AeroOptions, q, runs, options: RunOptions):
-    """The section held still at each of ``aopts.static_angles_deg``: (StaticCoefficients or None, records)."""
+def _static_results(recs, section, aopts: AeroOptions, options: RunOptions):
+    """The records of the section held still at each of ``aopts.static_angles_deg``: (StaticCoefficients or
+    None, their summaries)."""
     angles = aopts.static_angles_deg
     if not angles:
         return None, []
-    records, recs = [], []
-    for n, angle in enumerate(angles):
-        case = StaticCase(angle, grid_angle_deg=max(abs(a) for a in angles))
-        label = f"aero static {n + 1}/{len(angles)}, angle {angle:g} deg"
-        rec = run_case(poly, case, q, checkpoint_path(runs, poly, case, q), aopts.checkpoint_every,
-                       progress=options.say, label=label)
-        recs.append(rec)
-        records.append({"angle_deg": angle, "steps": rec.steps, "wall_s": rec.wall_s,
-                        "resumed_from_step": rec.resumed_from_step, "t": rec.t, "lift": rec.lift,
-                        "drag": rec.drag, "moment": rec.moment})
+    records = [{"angle_deg": angle, "steps": rec.steps, "wall_s": rec.wall_s,
+                "resumed_from_step": rec.resumed_from_step, "t": rec.t, "lift": rec.lift,
+                "drag": rec.drag, "moment": rec.moment} for angle, rec in zip(angles, recs, strict=True)]
     st = static_coefficients(recs, angles, section.depth_m / section.chord_m)
     cd0 = st.fit(st.drag)[0]
     if cd0 < 0.0:

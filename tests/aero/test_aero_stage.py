@@ -145,3 +145,30 @@ def test_the_grid_option_is_checked_and_picks_the_overset_pair():
     assert preset("quick", "overset").overset and not preset("quick").overset
     with pytest.raises(InputError, match="aero.grid"):
         preset("quick", "chimera")
+
+
+def test_cases_side_by_side_give_the_numbers_of_cases_one_after_the_other(tmp_path):
+    """run_cases with two worker processes (each case on one core) returns, in the jobs' order, the same
+    records bit for bit as the cases run one after the other here, and passes their progress lines on;
+    the errors a worker raises cross the process boundary intact (they are picklable)."""
+    import pickle
+    from dataclasses import replace
+
+    from bridge.aero.forced_motion import StaticCase, run_cases
+    from bridge.errors import ConvergenceError, DivergedError, InputError
+
+    poly = _unit_polygon(Rectangle(10.0, 2.0))
+    q = replace(QUALITY["tiny"], static_duration=1.0)
+    jobs = [(StaticCase(a), None, f"angle {a:g}") for a in (2.0, -1.0, 0.0)]
+    lines = []
+    apart = run_cases(poly, jobs, q, workers=2, progress=lines.append)
+    here = run_cases(poly, jobs, q, workers=1)
+    for a, b in zip(apart, here, strict=True):
+        np.testing.assert_array_equal(a.lift, b.lift)
+        np.testing.assert_array_equal(a.moment, b.moment)
+    assert apart[0].lift.mean() != apart[1].lift.mean()   # the order is the jobs' (different angles)
+    assert any(line.startswith("angle -1:") for line in lines) and any(line.startswith("angle 2:") for line in lines)
+    for err in (InputError("aero.quality", "tiny", "too coarse"), ConvergenceError("x", 3, 1.0, 0.1),
+                DivergedError("the CFD of heave", "NaN at t = 1")):
+        back = pickle.loads(pickle.dumps(err))
+        assert type(back) is type(err) and str(back) == str(err)
