@@ -21,6 +21,7 @@ import os
 import signal
 import sys
 import threading
+import time
 
 __all__ = ["Interrupts", "stop_quietly_while_loading", "exit_command", "INTERRUPTED"]
 
@@ -53,6 +54,9 @@ class Interrupts:
         self.finished = False
         self._previous = None
         self._hook = None
+        self._in_hook = False        # the unraisable hook is running (see _handler)
+        self._delivered = False      # the handler has raised KeyboardInterrupt in the main flow
+        self._redelivering = False
 
     def finish(self) -> None:
         """The interruption is being reported: further Ctrl-C (or one re-delivered late) is ignored, so
@@ -72,19 +76,42 @@ class Interrupts:
         return INTERRUPTED
 
     def _redeliver(self) -> None:
-        if not self.finished:
-            os.kill(os.getpid(), signal.SIGINT)
+        """Send SIGINT again until the handler has raised it in the main flow (a signal that lands while
+        the unraisable hook still runs is deferred by the handler, so try again), or the command ends."""
+        try:
+            time.sleep(0.001)
+            while not (self.finished or self._delivered):
+                os.kill(os.getpid(), signal.SIGINT)
+                deadline = time.monotonic() + 0.5   # a busy main thread may take a while to run the handler
+                while not (self.finished or self._delivered) and time.monotonic() < deadline:
+                    time.sleep(0.001)
+        finally:
+            self._redelivering = False
+
+    def _redeliver_soon(self) -> None:
+        if not self._redelivering:
+            self._redelivering = True
+            threading.Thread(target=self._redeliver, daemon=True).start()
 
     def _handler(self, signum, frame):
         self.fired = True
+        if self._in_hook:   # raised here, Python would swallow it like the first one: deliver it later
+            self._redeliver_soon()
+            return
+        self._delivered = True
         raise KeyboardInterrupt
 
     def _unraisable(self, info) -> None:
-        """An interrupt that landed in a destructor or weakref callback is swallowed there (Python
-        prints "Exception ignored in ..." and goes on): deliver it again, to the main flow."""
+        """An interrupt that landed in a destructor or weakref callback is swallowed there (Python prints
+        "Exception ignored in ..." and goes on): deliver it again, to the main flow, from another thread
+        (raised inside this hook, Python would swallow it once more)."""
         if isinstance(info.exc_value, KeyboardInterrupt):
-            # from another thread, so that it arrives after this hook has returned, not inside it
-            threading.Timer(0.001, self._redeliver).start()
+            self._in_hook = True
+            try:
+                self._delivered = False
+                self._redeliver_soon()
+            finally:
+                self._in_hook = False
         else:
             self._hook(info)
 
