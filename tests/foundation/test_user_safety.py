@@ -500,6 +500,6 @@ def test_an_interrupt_swallowed_by_a_destructor_is_delivered_again(capfd):
         Interrupted()          # the destructor's interrupt is swallowed by Python ...
         deadline = time.monotonic() + 10.0
         while time.monotonic() < deadline:  # ... and must reach the main flow again, here
-            time.sleep(0.001)   # (a busy loop of fixed length lost the race on a loaded CI machine)
+            time.sleep(0.001)
     assert interrupts.fired
     assert "Exception ignored" not in capfd.readouterr().err
