@@ -45,9 +45,9 @@ THESIS_TABLE_5_3 = {25.0: {"H_pu": 1.95e3, "H_mu": 1.66e4, "H_ptheta": 3.95e4, "
 
 
 def run_speed(speed: float, omega: float, quality: str, turbulence: str, runs: Path | None, say=print,
-              grid: str = "overset", **changes) -> dict:
+              grid: str = "overset", threads: int | None = None, **changes) -> dict:
     """Heave and pitch at one speed; ``changes``: fields of the preset to replace (a grid study's
-    cells_per_chord, cfl)."""
+    cells_per_chord, cfl); ``threads``: of each case (None: run_case's choice)."""
     section = great_belt_section()
     polys = _unit_polygons(section)
     q = replace(preset(quality, grid), **changes)
@@ -60,7 +60,7 @@ def run_speed(speed: float, omega: float, quality: str, turbulence: str, runs: P
         case = ForcedCase.thesis(dof, omega)
         t0 = time.perf_counter()
         rec = run_case(polys, case, q, checkpoint_path(runs, polys, case, q), progress=say,
-                       label=f"V = {speed:g} m/s {dof}")
+                       label=f"V = {speed:g} m/s {dof}", threads=threads)
         sel = whole_periods(rec, case, q)
         # the CFD's units are B = V = rho = 1: the fit gives the non-dimensional h_xy (Eq 4.37), which the
         # same response at the real speed, width and density turns into the thesis's H_xdot
@@ -120,12 +120,16 @@ def main(argv=None) -> int:
     ap.add_argument("--grid", default="overset", choices=["overset", "single"],
                     help="overset (default): the deck fixed in a body grid; single: the deck moving through one grid, "
                          "whose SST forces jitter as the deck's faces change class (docs/aero.md)")
+    ap.add_argument("--threads", type=int, default=None,
+                    help="CPU threads of each case (default: 2 on grids of 20 000 cells or more, else 1)")
     ap.add_argument("--out", default="out/reynolds_study.json")
     args = ap.parse_args(argv)
     if len(args.speeds) < 2 or any(not 1.0 <= v <= 200.0 for v in args.speeds):
         ap.error(f"--speeds: {args.speeds} not allowed; allowed: two or more speeds in 1 .. 200 m/s")
     if not 0.05 <= args.omega <= 5.0:
         ap.error(f"--omega: {args.omega} not allowed; allowed: 0.05 .. 5")
+    if args.threads is not None and not 1 <= args.threads <= 64:
+        ap.error(f"--threads: {args.threads} not allowed; allowed: 1 .. 64")
     import warp as wp
 
     wp.config.quiet = True
@@ -133,7 +137,8 @@ def main(argv=None) -> int:
     out.parent.mkdir(parents=True, exist_ok=True)
     runs = out.with_name(out.stem + "_runs")
     rows = [run_speed(v, args.omega, args.quality, args.turbulence, runs,
-                      say=lambda s: print(s, file=sys.stderr, flush=True), grid=args.grid) for v in sorted(args.speeds)]
+                      say=lambda s: print(s, file=sys.stderr, flush=True), grid=args.grid, threads=args.threads)
+            for v in sorted(args.speeds)]
     table = _table(rows)
     print(table)
     result = {"command": "python tools/reynolds_study.py " + " ".join(argv if argv is not None else sys.argv[1:]),

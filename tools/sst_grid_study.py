@@ -2,7 +2,7 @@
 thesis asks for the sensitivity of its CFD to the grid).
 
     python tools/sst_grid_study.py --cells 20 40 80 [--angles 0] [--omega 0.5] [--cfl 0.5]
-                                   [--quality quick] [--speed 50] [--out out/sst_grid_study.json]
+                                   [--quality quick] [--speed 50] [--threads N] [--out out/sst_grid_study.json]
 
 For each body-grid resolution (cells per chord; the background keeps the preset's coarsening, so it is
 refined with the body grid) the deck is held still at ``--angles`` (degrees, nose-up) for the preset's
@@ -52,7 +52,7 @@ def run_resolution(cells: int, args, runs: Path) -> dict:
         case = StaticCase(angle, grid_angle)
         t0 = time.perf_counter()
         rec = run_case(polys, case, q, checkpoint_path(runs, polys, case, q), progress=_say,
-                       label=f"{cells} cells per chord, {angle:g} deg")
+                       label=f"{cells} cells per chord, {angle:g} deg", threads=args.threads)
         c = static_coefficients([rec], [angle], section.depth_m / section.chord_m)
         row["static"][f"{angle:g}"] = {"C_D": float(c.drag[0]), "C_L": float(c.lift[0]), "C_M": float(c.moment[0]),
                                        "lift_rms": float(c.lift_rms[0]), "settling": c.settling[0].tolist(),
@@ -60,7 +60,7 @@ def run_resolution(cells: int, args, runs: Path) -> dict:
                                        "wall_s": time.perf_counter() - t0}
     if args.omega is not None:
         forced = run_speed(args.speed, args.omega, args.quality, "sst", runs, say=_say, grid="overset",
-                           cells_per_chord=cells, cfl=args.cfl)
+                           threads=args.threads, cells_per_chord=cells, cfl=args.cfl)
         row.update({name: forced[name] for name in RESPONSES if name in forced})
         row["forced_cases"] = forced["cases"]
     return row
@@ -103,6 +103,8 @@ def main(argv=None) -> int:
     ap.add_argument("--cfl", type=float, default=0.5)
     ap.add_argument("--quality", default="quick", choices=sorted(QUALITY))
     ap.add_argument("--speed", type=float, default=50.0, help="wind speed [m/s]: the Reynolds number V B / nu")
+    ap.add_argument("--threads", type=int, default=None,
+                    help="CPU threads of each case (default: 2 on grids of 20 000 cells or more, else 1)")
     ap.add_argument("--out", default="out/sst_grid_study.json")
     args = ap.parse_args(argv)
     if any(not 8 <= c <= 400 for c in args.cells):
@@ -115,6 +117,8 @@ def main(argv=None) -> int:
         ap.error(f"--cfl: {args.cfl} not allowed; allowed: 0.05 .. 1")
     if not 1.0 <= args.speed <= 200.0:
         ap.error(f"--speed: {args.speed} not allowed; allowed: 1 .. 200 m/s")
+    if args.threads is not None and not 1 <= args.threads <= 64:
+        ap.error(f"--threads: {args.threads} not allowed; allowed: 1 .. 64")
     import warp as wp
 
     wp.config.quiet = True
