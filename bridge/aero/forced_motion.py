@@ -566,22 +566,14 @@ class _SingleGridFlow:
     def describe(self) -> str:
         return f"{self.sim.grid.nx} x {self.sim.grid.ny} cells" + ("" if self.model is None else ", SST")
 
-    def _arrays(self) -> dict:
-        """The state a resumed run needs to continue bit for bit: the flow's, and the SST model's."""
-        out = {name: getattr(self.sim, name) for name in ("u", "v", "p")}
-        if self.model is not None:
-            out.update(self.model.state_arrays())
-        return out
-
     def checkpoint_arrays(self) -> dict:
-        return {name: a.numpy().copy() for name, a in self._arrays().items()}
+        """The state a resumed run needs to continue bit for bit: the flow's and the SST model's fields
+        (bridge.cfd.state)."""
+        return self.sim.state.arrays()
 
     def restore_arrays(self, arrays: dict, t: float, n_steps: int) -> None:
-        for name, a in self._arrays().items():
-            a.assign(arrays[name])
+        self.sim.state.assign(arrays)
         self.sim.t, self.sim.n_steps = t, n_steps
-        if self.model is not None:
-            self.model.restored()
 
 
 def _overset_flow(q: Quality, polys, case, threads):

@@ -5,7 +5,8 @@ bodies (``Simulation.add_body`` with a ``Polygon`` and a motion), then ``run`` w
 Plug-in points for later issues: ``Simulation.set_viscosity`` (cell field nu + nu_t from a turbulence
 model before each step), the grid object (metrics), the Poisson solver object, body motions
 (anything with ``pose(t)``/``velocity(t)``), stage hooks (``StageHook``). ``OversetPair``: a fine body grid
-moving with the body over a fixed background (overset.py). See docs/cfd.md.
+moving with the body over a fixed background (overset.py). ``Simulation.state`` (a ``FlowState``): the
+fields a resumed run needs, with save and load to HDF5. See docs/cfd.md.
 """
 
 from .bodies import Polygon, box_deck, circle, flat_plate
@@ -17,11 +18,12 @@ from .motion import HarmonicMotion, PrescribedMotion, Stationary, UniformTransla
 from .overset import OversetPair
 from .precision import DTYPE
 from .pressure import PoissonSolver
+from .state import FlowState
 from .time_stepping import TIME_SCHEMES, FlowConfig, FlowDiverged, Simulation, StageHook
 
 __all__ = [
     "BoundaryConditions", "CartesianGrid", "CFLMonitor", "DivergenceMonitor", "DTYPE", "FlowConfig",
-    "FlowDiverged", "ForceHistory", "GHOST", "HarmonicMotion", "ImmersedBody", "NaNMonitor",
+    "FlowDiverged", "FlowState", "ForceHistory", "GHOST", "HarmonicMotion", "ImmersedBody", "NaNMonitor",
     "OversetPair", "PoissonSolver", "Polygon", "PrescribedMotion", "Simulation", "StageHook", "Stationary",
     "TIME_SCHEMES",
     "UniformTranslation", "box_deck", "circle", "flat_plate", "max_divergence", "run", "stretched_faces",

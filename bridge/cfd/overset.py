@@ -450,27 +450,21 @@ class OversetPair:
 
     # --- checkpoint ---------------------------------------------------------------------------
     def checkpoint_arrays(self) -> dict[str, np.ndarray]:
-        """Everything a restart needs (with ``t`` and ``n_steps``): both grids' u, v, p, the body grid's
-        stream function of the last two steps (the hole's extrapolation) and the turbulence model's state."""
-        out = {f"{name}/{f}": getattr(sim, f).numpy().copy() for name, sim in (("background", self.background),
-                                                                             ("body", self.body)) for f in "uvp"}
+        """Everything a restart needs (with ``t`` and ``n_steps``): both grids' flow states (u, v, p and the
+        turbulence model's fields, bridge.cfd.state) and the body grid's stream function of the last two
+        steps (the hole's extrapolation)."""
+        out = {f"{name}/{f}": a for name, sim in (("background", self.background), ("body", self.body))
+               for f, a in sim.state.arrays().items()}
         out["psi_times"] = np.array([t for t, _ in self._psi_hist])
         for k, (_, psi) in enumerate(self._psi_hist):
             out[f"psi_{k}"] = psi
-        if self.model is not None:
-            out.update({name: a.numpy().copy() for name, a in self.model.state_arrays().items()})
         return out
 
     def restore_arrays(self, arrays: dict[str, np.ndarray], t: float, n_steps: int) -> None:
         for name, sim in (("background", self.background), ("body", self.body)):
-            for f in "uvp":
-                getattr(sim, f).assign(arrays[f"{name}/{f}"])
+            sim.state.assign({f: arrays[f"{name}/{f}"] for f in sim.state.fields})
             sim.t, sim.n_steps = float(t), int(n_steps)
         self.t, self.n_steps = float(t), int(n_steps)
         times = np.atleast_1d(arrays["psi_times"])
         self._psi_hist = [(float(tk), np.asarray(arrays[f"psi_{k}"])) for k, tk in enumerate(times)]
         self._fringe._t = self._hole._t = None
-        if self.model is not None:
-            for name, a in self.model.state_arrays().items():
-                a.assign(arrays[name])
-            self.model.restored()

@@ -38,6 +38,7 @@ from .grids import GHOST, CartesianGrid
 from .launch import ROW0, RowLauncher
 from .precision import WP_DTYPE
 from .pressure import PoissonSolver
+from .state import FlowState
 
 __all__ = ["FlowConfig", "Simulation", "StageHook", "TIME_SCHEMES", "FlowDiverged"]
 
@@ -128,6 +129,9 @@ class Simulation:
 
         ushape, vshape, pshape = (grid.storage_shape(f) for f in "uvp")
         self.u, self.v, self.p = z(ushape), z(vshape), z(pshape)
+        self.state = FlowState()   # what a resumed run needs; models add their fields (bridge.cfd.state)
+        for name in "uvp":
+            self.state.register(name, getattr(self, name))
         self.u_stage, self.v_stage = z(ushape), z(vshape)
         self.u_star, self.v_star = z(ushape), z(vshape)
         # predictor row blocks: one per CPU thread (the y-flux carried up the block), short blocks on CUDA
@@ -152,12 +156,15 @@ class Simulation:
                               grid.x_faces[0] + (np.arange(pshape[1]) - g + 0.5) * grid.dx,
                               grid.x_faces[0] + (np.arange(ushape[1]) - g) * grid.dx)
         self.hooks: list[StageHook] = []   # the overset coupling's frame and fringe (bridge.cfd.overset)
-        self.t = 0.0
-        self.n_steps = 0
         self.last_force = [np.zeros(3) for _ in self.bodies]
         self.nu_max = config.nu
         self.nu_rows = None   # largest nu of each cell row (ny,), where a viscosity field sets it (stable_dt)
         self.last_dt = 0.0
+
+    # the time of the state and the steps taken: kept with the fields (saved and loaded with them)
+    t = property(lambda self: self.state.t, lambda self, value: setattr(self.state, "t", float(value)))
+    n_steps = property(lambda self: self.state.n_steps,
+                       lambda self, value: setattr(self.state, "n_steps", int(value)))
 
     def add_body(self, polygon, motion, margin: int = 3):
         """Immerse a rigid polygon moving with ``motion``; returns the ``ImmersedBody``."""

@@ -109,6 +109,8 @@ class KOmegaSST:
         self.k = TransportedScalar(sim, "k", sides_k, initial=k_inf)
         self.omega = TransportedScalar(sim, "omega", sides_w, initial=omega_inf)
         self.update()
+        for name in self.state_arrays():   # saved and loaded with the flow (bridge.cfd.state)
+            sim.state.register(name, lambda name=name: self.state_arrays()[name], after_load=self.restored)
 
     def _box(self, body, pose) -> tuple[int, int, int, int]:
         """(i0, j0, ni, nj) in storage indices: the cells within the body's radius and 4 cells of its
@@ -190,7 +192,8 @@ class KOmegaSST:
     def state_arrays(self) -> dict:
         """What a resumed run needs to continue bit for bit: k, omega and what the last coefficient pass
         left for the next step (from the previous step's k and omega): the flow's nu + nu_t and the
-        diffusivities of the time-step limit (Warp arrays; ``restored`` after assigning them)."""
+        diffusivities of the time-step limit (Warp arrays, registered in the flow's ``state``, whose load
+        calls ``restored``)."""
         return {"k": self.k.q, "omega": self.omega.q, "nu_eff": self.sim.nu, "k_gamma": self.k.gamma,
                 "omega_gamma": self.omega.gamma}
 
@@ -298,11 +301,3 @@ class OversetSST:
 
     def stable_dt(self) -> float:
         return min(self.background.stable_dt(), self.body.stable_dt())
-
-    def state_arrays(self) -> dict:
-        return {f"{name}/sst_{key}": a for name, m in (("background", self.background), ("body", self.body))
-                for key, a in m.state_arrays().items()}
-
-    def restored(self) -> None:
-        self.background.restored()
-        self.body.restored()
