@@ -1,6 +1,7 @@
 """Flutter derivatives of a thin flat plate from forced-motion CFD against Theodorsen's (docs/aero.md).
 
     python tools/validate_aero.py --quality standard --reduced-velocities 4 8 12 [--thickness 0.02]
+                                  [--grid overset] [--turbulence sst --reynolds 1e6] [--threads N]
 
 Runs one heave and one pitch case per reduced velocity with the aero stage's runner (bridge.aero:
 thesis velocity amplitudes, transient periods dropped, harmonic fit over whole periods) and prints the
@@ -17,6 +18,7 @@ import argparse
 import json
 import sys
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -44,16 +46,27 @@ from bridge.flutter.derivatives import FRF, derivatives_from_frf  # noqa: E402
 NAMES = ("H1", "H2", "H3", "H4", "A1", "A2", "A3", "A4")
 
 
-def plate_derivatives(reduced_velocity: float, quality: str, thickness: float, say=print,
-                      runs: Path | None = None, grid: str = "single") -> dict:
-    poly = _unit_polygon(FlatPlate(1.0, thickness))
+def plate_quality(quality: str, grid: str, turbulence: str = "laminar", reynolds: float | None = None):
+    """The preset on ``grid``; with ``turbulence = "sst"`` the k-omega SST model at ``reynolds``."""
     q = preset(quality, grid)
+    if turbulence != "laminar":
+        q = replace(q, turbulence=turbulence, reynolds=float(reynolds))
+    elif reynolds is not None:
+        q = replace(q, reynolds=float(reynolds))
+    return q
+
+
+def plate_derivatives(reduced_velocity: float, quality: str, thickness: float, say=print,
+                      runs: Path | None = None, grid: str = "single", turbulence: str = "laminar",
+                      reynolds: float | None = None, threads: int | None = None) -> dict:
+    poly = _unit_polygon(FlatPlate(1.0, thickness))
+    q = plate_quality(quality, grid, turbulence, reynolds)
     K = 2 * np.pi / reduced_velocity
     h, wall = {}, 0.0
     for dof in ("heave", "pitch"):
         case = ForcedCase.thesis(dof, K)
         rec = run_case(poly, case, q, checkpoint_path(runs, poly, case, q), progress=say,
-                       label=f"U/(fB) = {reduced_velocity:g} {dof}")
+                       label=f"U/(fB) = {reduced_velocity:g} {dof}", threads=threads)
         wall += rec.wall_s
         sel = whole_periods(rec, case, q)
         (resp,) = forced_motion_response(rec.t[sel], rec.motion[sel], [K], dof=dof, speed_m_s=1.0, deck_width_m=1.0,
@@ -66,6 +79,7 @@ def plate_derivatives(reduced_velocity: float, quality: str, thickness: float, s
     cfd = derivatives_from_frf(np.array([K]), FRF(*(np.array([v]) for v in frf[:4])))
     ref = derivatives_from_frf(np.array([K]), Theodorsen().frf(np.array([K]), 1.0))
     row = {"reduced_velocity": reduced_velocity, "K": K, "quality": quality, "grid": grid, "thickness": thickness,
+           "turbulence": q.turbulence, "reynolds": q.reynolds,
            "cells": cells, "grids": rec.meta["grids"], "wall_s": wall, "periods_fitted": periods,
            "frf": {k: [v.real, v.imag] for k, v in h.items()}}
     for n in NAMES:
@@ -75,18 +89,19 @@ def plate_derivatives(reduced_velocity: float, quality: str, thickness: float, s
 
 
 def multi_frequency_check(reduced_velocities, quality: str, thickness: float, singles: list[dict], say=print,
-                          runs: Path | None = None, grid: str = "single") -> list:
+                          runs: Path | None = None, grid: str = "single", turbulence: str = "laminar",
+                          reynolds: float | None = None, threads: int | None = None) -> list:
     """One heave and one pitch run at all the reduced velocities at once (ForcedCase.multi_frequency, each
     sine at the single run's amplitude) against the single runs ``singles``: rows of
     (U/(fB), name, multi, single, |multi - single| / |single|)."""
     poly = _unit_polygon(FlatPlate(1.0, thickness))
-    q = preset(quality, grid)
+    q = plate_quality(quality, grid, turbulence, reynolds)
     Ks = tuple(sorted(2 * np.pi / np.asarray(reduced_velocities)))
     rows = []
     for dof, rate in (("heave", THESIS_HEAVE_RATE), ("pitch", THESIS_PITCH_RATE)):
         case = ForcedCase.multi_frequency(dof, Ks, rate)
         rec = run_case(poly, case, q, checkpoint_path(runs, poly, case, q), progress=say,
-                       label=f"multi-frequency {dof}")
+                       label=f"multi-frequency {dof}", threads=threads)
         sel = whole_periods(rec, case, q)
         out = forced_motion_response(rec.t[sel], rec.motion[sel], list(Ks), dof=dof, speed_m_s=1.0, deck_width_m=1.0,
                                      air_density_kg_m3=1.0, lift=rec.lift[sel], moment=rec.moment[sel],
@@ -109,17 +124,30 @@ def main(argv=None) -> int:
     ap.add_argument("--multi", action="store_true",
                     help="also one multi-frequency run per dof at all the reduced velocities (the largest over whole "
                          "numbers, e.g. 12 6 4) against the single runs (issue target: within 3 %%)")
+    ap.add_argument("--turbulence", default="laminar", choices=["laminar", "sst"],
+                    help="laminar at the preset's Reynolds number (default), or the k-omega SST model")
+    ap.add_argument("--reynolds", type=float, default=None,
+                    help="Reynolds number on the chord (default: the preset's; needed with --turbulence sst)")
+    ap.add_argument("--threads", type=int, default=None, help="CPU threads of each case (default: run_case's)")
     ap.add_argument("--out", type=Path, default=Path("out/validate_aero.json"))
     args = ap.parse_args(argv)
+    if args.turbulence == "sst" and args.reynolds is None:
+        ap.error("--turbulence sst needs --reynolds (e.g. 1e6)")
+    if args.reynolds is not None and not 1.0 <= args.reynolds <= 1e10:
+        ap.error(f"--reynolds: {args.reynolds} not allowed; allowed: 1 .. 1e10")
+    if args.threads is not None and not 1 <= args.threads <= 64:
+        ap.error(f"--threads: {args.threads} not allowed; allowed: 1 .. 64")
+    flow = {"turbulence": args.turbulence, "reynolds": args.reynolds, "threads": args.threads}
     t0 = time.perf_counter()
     if args.multi:   # checked before the single runs: the multi run needs U_max / m
         AeroOptions(excitation="multi", reduced_velocities=tuple(args.reduced_velocities))
     runs = args.out.parent / "validate_aero_runs"
     runs.mkdir(parents=True, exist_ok=True)
     say = lambda m: print(m, file=sys.stderr, flush=True)  # noqa: E731
-    rows = [plate_derivatives(uv, args.quality, args.thickness, say=say, runs=runs, grid=args.grid)
+    rows = [plate_derivatives(uv, args.quality, args.thickness, say=say, runs=runs, grid=args.grid, **flow)
             for uv in args.reduced_velocities]
     print(f"thin plate t/B = {args.thickness:g}, preset {args.quality!r}, {args.grid} grid, "
+          f"{rows[0]['turbulence']} at Re {rows[0]['reynolds']:.3g}, "
           f"{time.perf_counter() - t0:.0f} s ({rows[0]['grids']})")
     print("| U/(fB) | " + " | ".join(f"{n}* CFD / Theodorsen (diff)" for n in NAMES) + " |")
     print("|---|" + "---|" * len(NAMES))
@@ -129,7 +157,8 @@ def main(argv=None) -> int:
         print(f"| {r['reduced_velocity']:g} | " + " | ".join(cells) + " |")
     if args.multi:
         rv = AeroOptions(excitation="multi", reduced_velocities=tuple(args.reduced_velocities)).reduced_velocities
-        multi = multi_frequency_check(rv, args.quality, args.thickness, rows, say=say, runs=runs, grid=args.grid)
+        multi = multi_frequency_check(rv, args.quality, args.thickness, rows, say=say, runs=runs, grid=args.grid,
+                                      **flow)
         print("\n| U/(fB) | FRF | multi-frequency | single | difference |\n|---|---|---|---|---|")
         for uv, name, m, s1, d, _ in multi:
             print(f"| {uv:g} | {name} | {m.real:.3f} {m.imag:+.3f}i | {s1.real:.3f} {s1.imag:+.3f}i "
