@@ -103,11 +103,11 @@ def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
     warning = ("" if cells_across >= 2.0 else
                f"the section is {cells_across:.1f} cells thick on the {quality!r} grid (fewer than 2): the immersed "
                "boundary barely sees it and the forces are not to be trusted; use a finer preset")
-    if q.turbulence == "sst" and q.cells_per_chord > 40:
+    if q.turbulence == "sst" and q.cells_per_chord > 80:
         warning = "; ".join(w for w in (warning, (
-            f"SST on the {quality!r} preset ({q.cells_per_chord} cells per chord) is untested: the one run finer than "
-            "'quick' (80 cells per chord, the Great Belt deck) diverged at the deck's trailing edge with the wall "
-            "function (docs/aero.md); a run that diverges stops with exit status 3")) if w)
+            f"SST on the {quality!r} preset ({q.cells_per_chord} cells per chord) is untested: the finest SST runs "
+            "had 80 cells per chord (the Great Belt deck's grid study, docs/aero.md); a run that diverges stops "
+            "with exit status 3")) if w)
     if warning:
         options.say(f"aero: WARNING {warning}")
     Ks = np.array(sorted(2 * np.pi / np.asarray(aopts.reduced_velocities)))
