@@ -82,6 +82,19 @@ def run_speed(speed: float, omega: float, quality: str, turbulence: str, runs: P
     return row
 
 
+def start_study(ap: argparse.ArgumentParser, args) -> tuple[Path, Path]:
+    """What a study tool does once its own arguments are checked: check ``--threads``, quiet Warp, make
+    the folder of ``--out``; returns the output file and the folder of the cases' checkpoints beside it."""
+    if args.threads is not None and not 1 <= args.threads <= 64:
+        ap.error(f"--threads: {args.threads} not allowed; allowed: 1 .. 64")
+    import warp as wp
+
+    wp.config.quiet = True
+    out = Path(args.out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    return out, out.with_name(out.stem + "_runs")
+
+
 def _table(rows: list[dict]) -> str:
     keys = [("H_pu", "|H_pudot| [N s/m^2]"), ("H_mu", "|H_mudot| [N s/m]"), ("H_ptheta", "|H_pthetadot| [N s/m]"),
             ("H_mtheta", "|H_mthetadot| [N s]"), ("phi_pu", "phi_pu [rad]"), ("phi_mu", "phi_mu [rad]"),
@@ -128,14 +141,7 @@ def main(argv=None) -> int:
         ap.error(f"--speeds: {args.speeds} not allowed; allowed: two or more speeds in 1 .. 200 m/s")
     if not 0.05 <= args.omega <= 5.0:
         ap.error(f"--omega: {args.omega} not allowed; allowed: 0.05 .. 5")
-    if args.threads is not None and not 1 <= args.threads <= 64:
-        ap.error(f"--threads: {args.threads} not allowed; allowed: 1 .. 64")
-    import warp as wp
-
-    wp.config.quiet = True
-    out = Path(args.out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    runs = out.with_name(out.stem + "_runs")
+    out, runs = start_study(ap, args)
     rows = [run_speed(v, args.omega, args.quality, args.turbulence, runs,
                       say=lambda s: print(s, file=sys.stderr, flush=True), grid=args.grid, threads=args.threads)
             for v in sorted(args.speeds)]

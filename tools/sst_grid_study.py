@@ -27,7 +27,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from reynolds_study import NU_AIR, run_speed  # noqa: E402
+from reynolds_study import NU_AIR, run_speed, start_study  # noqa: E402
 
 from bridge.aero.forced_motion import QUALITY, StaticCase, checkpoint_path, preset, run_case  # noqa: E402
 from bridge.aero.stage import _unit_polygons  # noqa: E402
@@ -117,14 +117,7 @@ def main(argv=None) -> int:
         ap.error(f"--cfl: {args.cfl} not allowed; allowed: 0.05 .. 1")
     if not 1.0 <= args.speed <= 200.0:
         ap.error(f"--speed: {args.speed} not allowed; allowed: 1 .. 200 m/s")
-    if args.threads is not None and not 1 <= args.threads <= 64:
-        ap.error(f"--threads: {args.threads} not allowed; allowed: 1 .. 64")
-    import warp as wp
-
-    wp.config.quiet = True
-    out = Path(args.out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    runs = out.with_name(out.stem + "_runs")
+    out, runs = start_study(ap, args)
     command = "python tools/sst_grid_study.py " + " ".join(argv if argv is not None else sys.argv[1:])
     rows = []
     for c in sorted(args.cells):   # the file holds every finished resolution, so a long study shows as it goes

@@ -22,6 +22,7 @@ uninterrupted run (the step is a one-step scheme whose only state is those array
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import math
@@ -452,12 +453,10 @@ def run_cases(shape, jobs, quality: Quality, checkpoint_every: int = 2000,
         stopping.set()
         for f in futures:
             f.cancel()
-        for child in list(getattr(pool, "_processes", {}).values()):   # the running cases stop cleanly
-            if child.pid is not None and child.is_alive():
-                try:
+        for child in multiprocessing.active_children():   # the running cases stop cleanly (as bridge.sweep)
+            if child.pid is not None:
+                with contextlib.suppress(OSError):
                     os.kill(child.pid, signal.SIGINT)
-                except OSError:
-                    pass
         pool.shutdown(wait=True, cancel_futures=True)
         drain()
         raise
