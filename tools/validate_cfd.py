@@ -35,6 +35,7 @@ import json
 import sys
 import time
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
@@ -59,6 +60,7 @@ from bridge.cfd import (  # noqa: E402
     stretched_faces,
 )
 from bridge.cfd.advection import SCHEMES  # noqa: E402
+from bridge.cfd.time_stepping import TIME_SCHEMES  # noqa: E402
 
 BANDS = {  # docs/reference_cases.md
     20: {"C_D": (2.00, 2.09), "L_w/D": (0.91, 0.94)},
@@ -227,13 +229,39 @@ class ControlVolumeLift:
 DFG_D, DFG_H = 0.1, 0.41  # cylinder diameter, channel height
 
 
+class DfgVariant(NamedTuple):
+    """Changes to the DFG channel for a sensitivity study (the defaults are the benchmark's): the channel's
+    length (the outflow's distance), its walls ("noslip" or "slip"), the viscosity's factor (Re = 100 /
+    nu_scale in 2D-2), the time step's Courant number and scheme, and the walls' first cell as a fraction of
+    h (``wall_cell`` < 1: y spacing growing by 10 % from it to h, uniform h in the middle)."""
+
+    channel_length: float = 2.2
+    walls: str = "noslip"
+    nu_scale: float = 1.0
+    cfl: float = 0.5
+    time_scheme: str = "heun"
+    wall_cell: float = 1.0
+
+
+def _wall_refined_faces(height, h, first):
+    """y faces on [0, height]: ``first`` h at each wall, growing by 10 % up to h, uniform h between."""
+    side, step = [0.0], first * h
+    while step < h or side[-1] < 3 * h:
+        side.append(side[-1] + step)
+        step = min(h, 1.1 * step)
+    side = np.array(side)
+    n_mid = max(1, int(round((height - 2 * side[-1]) / h)))
+    mid = np.linspace(side[-1], height - side[-1], n_mid + 1)
+    return np.concatenate([side, mid[1:-1], height - side[::-1]])
+
+
 def dfg_cells_across(ppd):
     """Cells across the DFG channel at h = D/ppd (before any ``ny_shift``)."""
     return int(round(DFG_H / (DFG_D / ppd)))
 
 
 def dfg(ppd, t_end, threads, scheme, ib_order=1, ny_shift=0, overset=None, body_shift=0.0, unsteady=False,
-        window=3.0, series_out=None, body_extent=1.0, cv_lift=False):
+        window=3.0, series_out=None, body_extent=1.0, cv_lift=False, variant=None):
     """DFG 2D-1 on a uniform grid h = D/ppd; ``ny_shift`` adds cells across the channel (dy =
     0.41/(ny + ny_shift), nearly the same resolution, the cylinder cut differently by the grid).
     ``overset`` = background cells per diameter: the cylinder in a body grid of h = D/ppd spanning
@@ -242,19 +270,25 @@ def dfg(ppd, t_end, threads, scheme, ib_order=1, ny_shift=0, overset=None, body_
     differently).
     ``unsteady``: DFG 2D-2 (U_max = 1.5, Re 100, periodic shedding): c_D,max, c_L,max and St over the
     last ``window``, the force series written to ``series_out`` (.h5 and .png). ``cv_lift`` (single
-    grid): also the lift from a control volume of +-1.5 D (``ControlVolumeLift``)."""
-    d, h_ch, length, nu, umax = DFG_D, DFG_H, 2.2, 1e-3, (1.5 if unsteady else 0.3)
+    grid): also the lift from a control volume of +-1.5 D (``ControlVolumeLift``). ``variant`` (a
+    ``DfgVariant``): the sensitivity changes of ``--channel-length`` and the options after it."""
+    v = variant or DfgVariant()
+    d, h_ch, length, nu, umax = DFG_D, DFG_H, v.channel_length, 1e-3 * v.nu_scale, (1.5 if unsteady else 0.3)
 
     def profile(y, t):
         return 4 * umax * y * (h_ch - y) / h_ch ** 2
 
-    bc = BoundaryConditions(left="inflow", right="outflow", bottom="noslip", top="noslip", inflow_profile=profile)
-    cfg = FlowConfig(nu=nu, advection=scheme, cfl=0.5, fourier=0.2, threads=threads, bc=bc)
+    bc = BoundaryConditions(left="inflow", right="outflow", bottom=v.walls, top=v.walls, inflow_profile=profile)
+    cfg = FlowConfig(nu=nu, advection=scheme, cfl=v.cfl, fourier=0.2, threads=threads, bc=bc,
+                     time_scheme=v.time_scheme)
     bg_ppd = overset if overset is not None else ppd
     h = d / bg_ppd
     nx = int(round(length / h))
     ny = dfg_cells_across(bg_ppd) + ny_shift
     grid = CartesianGrid.uniform(nx, ny, (0.0, length), (0.0, h_ch))
+    if v.wall_cell < 1.0:
+        grid = CartesianGrid(grid.x_faces, _wall_refined_faces(h_ch, h, v.wall_cell))
+        ny = grid.ny
     yc = grid.y_centres
     u0 = np.broadcast_to(profile(yc, 0)[:, None], (ny, nx + 1))
     t0 = time.perf_counter()
@@ -296,7 +330,7 @@ def dfg(ppd, t_end, threads, scheme, ib_order=1, ny_shift=0, overset=None, body_
                "body_extent": body_extent if overset else None,
                "cells": cells, "t_end": float(t[-1]), "steps": steps, "wall_s": wall, "window": window,
                "c_D_max": float(cd[sel].max()), "c_L_max": float(cl[sel].max()), "c_L_min": float(cl[sel].min()),
-               "St": st * d / um, "band": BANDS["dfg2"]}
+               "St": st * d / um, "variant": v._asdict(), "band": BANDS["dfg2"]}
         if cv_lift and overset is None:
             cl_cv = scale * np.array(monitors[-1].f)
             row.update(c_L_max_cv=float(cl_cv[sel].max()), c_L_min_cv=float(cl_cv[sel].min()),
@@ -308,7 +342,7 @@ def dfg(ppd, t_end, threads, scheme, ib_order=1, ny_shift=0, overset=None, body_
             "body_extent": body_extent if overset else None,
             "cells": cells, "nx": nx, "ny": ny,
             "t_end": float(t[-1]), "steps": steps, "wall_s": wall, "blockage": d / h_ch, "advection": scheme,
-            "ib_order": ib_order, "ny_shift": ny_shift, "c_D": float(scale * f[-1, 0]),
+            "ib_order": ib_order, "ny_shift": ny_shift, "variant": v._asdict(), "c_D": float(scale * f[-1, 0]),
             "c_L": float(scale * f[-1, 1]), "dp": dp, "dp_linear": dp_linear,
             "c_D_drift_per_time": float(np.polyfit(t[last] - t[-1], scale * f[last, 0], 1)[0])
             if last.sum() > 2 else np.nan,
@@ -425,6 +459,14 @@ def main(argv=None):
     ap.add_argument("--cv-lift", action="store_true",
                     help="dfg2 on the single grid: also the lift from a control-volume momentum balance of +-1.5 D "
                          "(a check of the immersed boundary's force)")
+    sens = ap.add_argument_group("dfg, dfg2 sensitivity (what moves the forces; defaults: the benchmark's)")
+    sens.add_argument("--channel-length", type=float, default=2.2, help="channel length (the outflow's distance)")
+    sens.add_argument("--walls", choices=["noslip", "slip"], default="noslip", help="the channel's walls")
+    sens.add_argument("--nu-scale", type=float, default=1.0, help="viscosity factor (Re = 100 / NU_SCALE in dfg2)")
+    sens.add_argument("--cfl", type=float, default=0.5, help="Courant number of the time step")
+    sens.add_argument("--time-scheme", choices=sorted(TIME_SCHEMES), default="heun")
+    sens.add_argument("--wall-cell", type=float, default=1.0,
+                      help="the walls' first cell over h (< 1: refined towards the walls, single grid)")
     ap.add_argument("--out", default="out/validation_cfd.jsonl")
     args = ap.parse_args(argv)
     wp.config.quiet = True
@@ -448,7 +490,9 @@ def main(argv=None):
                 r = dfg(ppd, args.t_end, args.threads, args.advection, args.ib_order,
                         0 if args.overset else variant, args.overset, variant if args.overset else 0.0,
                         unsteady=args.case == "dfg2", window=min(args.window, args.t_end / 2), series_out=stem,
-                        body_extent=args.body_extent, cv_lift=args.cv_lift)
+                        body_extent=args.body_extent, cv_lift=args.cv_lift,
+                        variant=DfgVariant(args.channel_length, args.walls, args.nu_scale, args.cfl,
+                                           args.time_scheme, args.wall_cell))
             r["command"] = command
             _emit(r, args.out)
             results.append(r)
@@ -462,6 +506,13 @@ def _check_args(ap, args):
               ("--t-end", args.t_end, args.t_end > 0, "> 0"),
               ("--window", args.window, args.window > 0, "> 0"),
               ("--threads", args.threads, args.threads >= 1, ">= 1"),
+              ("--channel-length", args.channel_length, 1.0 <= args.channel_length <= 20.0,
+               "1 .. 20 (the cylinder sits at x = 0.2)"),
+              ("--nu-scale", args.nu_scale, 0.1 <= args.nu_scale <= 10.0, "0.1 .. 10"),
+              ("--cfl", args.cfl, 0.0 < args.cfl <= 1.0, "(0, 1]"),
+              ("--wall-cell", args.wall_cell,
+               0.05 <= args.wall_cell <= 1.0 and (args.wall_cell == 1.0 or args.overset is None),
+               "0.05 .. 1, below 1 only on the single grid"),
               ("--body-extent", args.body_extent, 0.75 <= args.body_extent <= 1.6,
                "0.75 .. 1.6 D (the body grid must hold the cylinder and the hole, and its fringe must stay clear "
                "of the channel's wall 2 D from the centre)"),

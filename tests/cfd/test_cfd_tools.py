@@ -35,6 +35,11 @@ def test_validate_cfd_runs_tiny(tmp_path):
     with pytest.raises(SystemExit):  # no cells left: refused before any run
         load_tool("validate_cfd").main(["dfg", "--ppd", "6", "--ny-shift", "-25", "--out", str(out)])
     assert len(out.read_text().splitlines()) == 5
+    # the sensitivity options reach the run: walls refined (more rows than the 25 of h), slip walls, a longer
+    # channel, and the variant recorded with the result
+    (res,) = load_tool("validate_cfd").main(["dfg", "--ppd", "6", "--t-end", "0.02", "--wall-cell", "0.25", "--walls",
+                                             "slip", "--channel-length", "3.3", "--out", str(tmp_path / "s.jsonl")])
+    assert res["ny"] > 25 and res["nx"] == 198 and res["variant"]["walls"] == "slip"
 
 
 @pytest.mark.parametrize("tool, argv, option", [
