@@ -10,6 +10,7 @@ from bridge.aero.frequency_response import (
     HarmonicFit,
     ThesisExtraction,
     displacement_frf,
+    distortion,
     forced_motion_response,
     frf_table,
     harmonic_fit,
@@ -21,5 +22,5 @@ from bridge.aero.frequency_response import (
 )
 
 __all__ = ["DOFS", "FRF_OF_RUN", "LOADS", "FrequencyResponse", "FRFGrid", "HarmonicFit", "ThesisExtraction",
-           "displacement_frf", "forced_motion_response", "frf_table", "harmonic_fit", "normalised_frf",
+           "displacement_frf", "distortion", "forced_motion_response", "frf_table", "harmonic_fit", "normalised_frf",
            "rate_frf", "speed_independent_table", "tabulate", "thesis_extraction"]

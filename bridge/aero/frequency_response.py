@@ -47,7 +47,7 @@ from bridge.flutter.tables import FRFTable
 
 __all__ = ["HarmonicFit", "harmonic_fit", "ThesisExtraction", "thesis_extraction", "rate_frf",
            "displacement_frf", "normalised_frf", "FRF_OF_RUN", "DOFS", "LOADS", "FrequencyResponse",
-           "forced_motion_response", "FRFGrid", "tabulate", "frf_table", "speed_independent_table"]
+           "forced_motion_response", "distortion", "FRFGrid", "tabulate", "frf_table", "speed_independent_table"]
 
 DOFS = ("heave", "pitch", "sway")
 LOADS = ("lift", "drag", "moment")
@@ -237,6 +237,24 @@ def harmonic_fit(t: np.ndarray, signal: np.ndarray, omegas: float | Iterable[flo
     return HarmonicFit(omegas=w, amplitudes=amplitudes, stderr=_standard_error(per_period),
                        per_period=per_period, periods=n, period=T0, window=(t_start, t_end),
                        mean=float(coef[0]), drift_rate=drift_rate, residual_rms=residual_rms)
+
+
+def distortion(t: np.ndarray, signal: np.ndarray, omegas: Iterable[float], fundamental: float) -> float:
+    """How far a multi-frequency run's load is from a linear response: the rms amplitude of ``signal`` at the
+    multiples of ``fundamental`` up to twice the highest of ``omegas`` that the motion does not contain, over
+    the rms amplitude at ``omegas`` (the same window and fit as :func:`harmonic_fit`).
+
+    A linear section answers only at the frequencies it is moved at (ratio ~ 0, the noise).  Products of the
+    motion's sines (a quadratic or cubic response, or shedding locked to the motion) land on sums and
+    differences of them: on the lines counted here and, since the set is made of whole multiples of one
+    frequency, also on the moved lines themselves, where they bias the FRFs by about as much."""
+    w = np.sort(np.asarray(list(omegas), dtype=np.float64))
+    m = np.round(w / fundamental).astype(int)
+    lines = np.arange(1, 2 * int(m.max()) + 1)
+    fit = harmonic_fit(t, signal, fundamental * lines, fundamental=fundamental)
+    moved = np.isin(lines, m)
+    a = np.abs(fit.amplitudes)
+    return float(np.sqrt(np.mean(a[~moved] ** 2)) / max(np.sqrt(np.mean(a[moved] ** 2)), 1e-300))
 
 
 # ---------------------------------------------------------------------------------------------------

@@ -14,6 +14,7 @@ import pytest
 from bridge.aero import (
     FrequencyResponse,
     displacement_frf,
+    distortion,
     forced_motion_response,
     frf_table,
     harmonic_fit,
@@ -137,6 +138,19 @@ def test_three_sines_are_recovered_term_by_term(multiples, fundamental):
     n = np.count_nonzero(t >= noisy.window[0])
     assert np.all(np.abs(noisy.amplitudes - amplitudes) < 4 * sigma * np.sqrt(4 / n))
     assert np.all(np.abs(noisy.amplitudes - amplitudes) < 4 * np.abs(noisy.stderr))
+
+
+@pytest.mark.parametrize("eps", [0.0, 0.05, 0.2])
+def test_the_distortion_of_a_quadratic_response_to_two_sines_is_the_closed_form(eps):
+    """x = sin(w0 t) + sin(2 w0 t), load y = x + eps x^2: x^2 = 1 - cos(2a)/2 - cos(4a)/2 + cos(a) - cos(3a)
+    (a = w0 t), so the moved lines carry amplitudes sqrt(1 + eps^2) and sqrt(1 + eps^2/4), the others (3 and 4
+    w0) eps and eps/2: distortion = eps sqrt(5/8) / sqrt(1 + 5 eps^2/8).  Uneven steps, four periods."""
+    rng = np.random.default_rng(3)
+    t = uneven_times(rng, 4.3)
+    x = np.sin(W * t) + np.sin(2 * W * t)
+    got = distortion(t, x + eps * x**2, [W, 2 * W], W)
+    expected = eps * np.sqrt(5 / 8) / np.sqrt(1 + 5 * eps**2 / 8)
+    assert got == pytest.approx(expected, rel=1e-3, abs=1e-6)
 
 
 def test_frequencies_that_are_not_multiples_of_the_fundamental_are_refused():
