@@ -13,7 +13,9 @@ Keys (all optional):
     excitation            "single": one heave and one pitch run per reduced velocity (default); "multi": one
                           heave and one pitch run moving at all of them at once (a sum of sines,
                           bridge.aero.forced_motion.ForcedCase.multi_frequency); the reduced velocities must
-                          then be the largest one over whole numbers (e.g. 16, 8, 5.333, 4)
+                          then be the largest one over whole numbers (e.g. 16, 8, 5.333, 4); a run whose
+                          loads are not linear in the motion is flagged in a warning (the Great Belt deck in
+                          pitch is not: docs/aero.md)
     grid                  "overset" (default): the section in a fine grid that moves with it over a coarser
                           fixed background (bridge/cfd/overset.py; no face of the body changes class as it
                           moves); "single": one grid, the section an immersed body moving on it (with "sst"
