@@ -96,14 +96,12 @@ def _overset(args) -> int:
     """Blocks of the pair's step without and with its SST model (module doc)."""
     from dataclasses import replace
 
-    from bridge.aero.forced_motion import ForcedCase, _overset_flow, preset
+    from bridge.aero.forced_motion import QUICK_UNTIL_2026_12_02, ForcedCase, _overset_flow
     from bridge.aero.stage import _unit_polygons
     from bridge.cfd.sections import great_belt_section
 
-    # the pair of docs/performance.md: 40 cells per chord on a 2 / 10 / 2 chord domain (the quick preset's until
-    # 2026-12-02)
-    q = replace(preset("standard", "overset"), turbulence="sst", reynolds=1.05e8, upstream=2.0, downstream=10.0,
-                half_height=2.0)
+    # the pair of docs/performance.md: 40 cells per chord on a 2 / 10 / 2 chord domain
+    q = replace(QUICK_UNTIL_2026_12_02, overset=True, turbulence="sst", reynolds=1.05e8)
     pair = _overset_flow(q, _unit_polygons(great_belt_section()), ForcedCase.thesis("heave", 0.5), None)
     model = pair.model
     dt = pair.stable_dt()

@@ -28,7 +28,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from bridge.aero.forced_motion import QUALITY, StaticCase, run_case  # noqa: E402
+from bridge.aero.forced_motion import QUALITY, QUICK_UNTIL_2026_12_02, StaticCase, run_case  # noqa: E402
 from bridge.aero.stage import _unit_polygons  # noqa: E402
 from bridge.aero.static import static_coefficients  # noqa: E402
 from bridge.cfd import Polygon, circle  # noqa: E402
@@ -49,7 +49,7 @@ def cylinder(cells: int, duration: float) -> dict:
     # turned by a fraction of a facet and moved off the grid's mirror line by 0.3 cells: a start that is not
     # mirror-symmetric, so that shedding sets in within a few tens of D/U instead of growing from round-off
     poly = Polygon(poly.vertices @ np.array([[c, s], [-s, c]]) + np.array([0.0, 0.3 / cells]))
-    q = dataclasses.replace(QUALITY["standard"], name=f"cylinder D/{cells}", cells_per_chord=cells, dy_over_dx=1.0,
+    q = dataclasses.replace(QUICK_UNTIL_2026_12_02, name=f"cylinder D/{cells}", cells_per_chord=cells, dy_over_dx=1.0,
                             upstream=8.0, downstream=20.0, half_height=10.0, core_half_height=1.0, reynolds=100.0,
                             static_duration=duration)
     rec = run_case(poly, StaticCase(0.0), q, progress=_say, label=f"cylinder D/{cells}")
@@ -95,9 +95,8 @@ def main(argv=None) -> int:
     elif args.case == "plate":
         poly = _unit_polygons(FlatPlate(1.0, args.thickness))
         for n in args.cells or [24, 40]:
-            # the domain and run length of the runs in docs/aero.md (the quick preset's until 2026-12-02)
-            q = dataclasses.replace(QUALITY["standard"], name=f"plate {n}/chord", cells_per_chord=n, upstream=2.0,
-                                    downstream=10.0, half_height=2.0)
+            # the domain and run length of the runs in docs/aero.md
+            q = dataclasses.replace(QUICK_UNTIL_2026_12_02, name=f"plate {n}/chord", cells_per_chord=n)
             r = sweep(poly, args.thickness, q)
             rows.append({"case": "plate", "cells_per_chord": n, **r})
             (_, dcl), (_, dcm) = r["fits"]["lift"], r["fits"]["moment"]

@@ -40,6 +40,7 @@ from bridge.errors import DivergedError, InputError, check_range
 
 __all__ = ["Quality", "QUALITY", "ForcedCase", "StaticCase", "ForceRecord", "run_case", "case_key",
            "checkpoint_path", "whole_periods", "run_cases", "default_workers", "preset", "GRIDS", "TURBULENCE",
+           "QUICK_UNTIL_2026_12_02",
            "THESIS_HEAVE_RATE", "THESIS_PITCH_RATE"]
 
 TURBULENCE = ("laminar", "sst")
@@ -111,6 +112,10 @@ QUALITY = {
                     static_duration=40.0),
 }
 
+
+# The quick preset as it was until 2026-12-02 (40 cells per chord, 2 / 10 / 2 chords): the grid of the runs
+# documented before then (docs/aero.md), kept for the tools and tests that repeat them; not a user preset.
+QUICK_UNTIL_2026_12_02 = Quality("quick", 40, 0.25, 2.0, 10.0, 2.0, 0.2, 1000.0, periods=4, discard_periods=2)
 
 GRIDS = ("single", "overset")
 
