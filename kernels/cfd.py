@@ -500,12 +500,23 @@ def square_to_wall(x: wp.float64, y: wp.float64, pos: wp.vec3d, verts: wp.array(
     return ok
 
 
+@wp.func
+def projected(q: wp.array2d(dtype=wp.float64), p: wp.array2d(dtype=wp.float64), hy_f: wp.array(dtype=wp.float64),
+              dx: wp.float64, cgrad: wp.float64, compensate: int, comp: int, J: int, I: int):
+    """The predicted face value as the projection will leave it, q - cgrad (grad p) with the latest
+    pressure (``compensate`` 1), or q itself (``compensate`` 0)."""
+    if compensate != 0:
+        return q[J, I] - cgrad * face_gradient(p, hy_f, dx, comp, J, I)
+    return q[J, I]
+
+
 @wp.kernel
 def ib_targets(q: wp.array2d(dtype=wp.float64), phi: wp.array2d(dtype=wp.float64),
                x0: wp.float64, dx: wp.float64, xoff: wp.float64, yc: wp.array(dtype=wp.float64),
                pos: wp.vec3d, vel: wp.vec3d, comp: int, i0: int, j0: int, ni: int,
                ilo: int, ihi: int, jlo: int, jhi: int, order: int, wall_law: int, nu: wp.float64,
-               verts: wp.array(dtype=wp.vec2d),
+               verts: wp.array(dtype=wp.vec2d), p: wp.array2d(dtype=wp.float64),
+               hy_f: wp.array(dtype=wp.float64), cgrad: wp.float64, compensate: int,
                target: wp.array2d(dtype=wp.float64), state: wp.array2d(dtype=wp.int32)):
     """Direct-forcing target of each face in the box (state: 0 fluid, 1 solid, 2 interface).
 
@@ -513,7 +524,9 @@ def ib_targets(q: wp.array2d(dtype=wp.float64), phi: wp.array2d(dtype=wp.float64
     grid line take the linear interpolation (Fadlun et al. 2000) between the body velocity at the
     interface point (distance d found from phi along the line) and the next fluid face:
     q_f = q_b + (q_o - q_b) d / (d + h) (``order`` 1), or the quadratic through q_b, q_o and the face
-    after q_o (``order`` 2); estimates from several lines are averaged. ``wall_law`` 1 (with ``order``
+    after q_o (``order`` 2); estimates from several lines are averaged. The neighbours q_o, q_oo are
+    taken as the projection will leave them (``projected``: q - cgrad grad p with the latest pressure,
+    ``compensate`` 1; bridge.cfd.immersed). ``wall_law`` 1 (with ``order``
     1): the wall function of a turbulent flow at high Reynolds number - for the component across the
     line (u on a vertical line, v on a horizontal one), q_f = q_b + (q_o - q_b) r with r = u(phi_f) /
     u(phi_o) on Spalding's law of the wall through q_o (``kernels.wall_law``; phi: the faces' distances
@@ -565,13 +578,13 @@ def ib_targets(q: wp.array2d(dtype=wp.float64), phi: wp.array2d(dtype=wp.float64
                         xb = x + wp.float64(di) * d
                         yb = y + wp.float64(dj) * d
                         qb = rigid_velocity(xb, yb, pos, vel, comp)
-                        qo = q[J - dj, I - di]
+                        qo = projected(q, p, hy_f, dx, cgrad, compensate, comp, J - dj, I - di)
                         ho = h
                         if dj != 0:
                             ho = wp.abs(yc[J - dj] - yc[J])
                         if order == 2:
                             # quadratic through the wall point and the next two faces on the line
-                            qoo = q[J - 2 * dj, I - 2 * di]
+                            qoo = projected(q, p, hy_f, dx, cgrad, compensate, comp, J - 2 * dj, I - 2 * di)
                             hoo = h
                             if dj != 0:
                                 hoo = wp.abs(yc[J - 2 * dj] - yc[J - dj])

@@ -17,7 +17,12 @@ D(G phi) in the cut cells that does not shrink with dt or h and biased the press
 body: DFG 2D-1 pressure difference 0.141-0.143 at D/16-D/48 against 0.1175, with c_D nearly right.
 With the compensation: 0.1160 (D/16), 0.1174 (D/32). At a steady state the forced faces then hold
 the target exactly and the pressure at fluid faces is decoupled from the forced ones, as with a
-Neumann condition on the interface.
+Neumann condition on the interface. The target itself is interpolated from the neighbouring faces as
+the projection will leave them, q* - c G p (``kernels.cfd.projected``): the predicted q* lacks the
+pressure gradient (the "full" form), so interpolating from it put the forced face on a line through a
+neighbour that the projection then moves by c G p, a wall-profile error of order dt. With the
+estimate the error is of order dt^2, as in the incremental form; DFG 2D-2's lift amplitude rose by
+1.8 % at D/16 and 0.8 % at D/32 (docs/validation.md).
 
 Mass (``_close_targets``): a cell whose four faces are all forced (solid faces and interface faces
 together) gets no free face for the projection to adjust, and the interpolated interface targets
@@ -165,7 +170,9 @@ class ImmersedBody:
                                                  self.pos, self.vel, comp, b["i0"], b["j0"], b["ni"],
                                                  ilo, ihi, jlo, jhi, self.order, int(self.wall_law is not None),
                                                  0.0 if self.wall_law is None else float(self.wall_law),
-                                                 self.verts, b["target"], b["state"]])
+                                                 self.verts, p if p is not None else q, self.hy_v,
+                                                 float(c), int(p is not None),
+                                                 b["target"], b["state"]])
         self._close_targets()
         for comp, q in ((0, u), (1, v)):
             b = self.boxes[comp]
