@@ -52,6 +52,7 @@ from bridge.cfd import (  # noqa: E402
     ImmersedBody,
     NaNMonitor,
     OversetPair,
+    ProgressNote,
     Simulation,
     Stationary,
     box_deck,
@@ -116,7 +117,7 @@ def cylinder(re, ppd, t_end, window, threads, scheme, upstream=10.0, downstream=
         sim.set_state(u=1.0, v=0.05 * np.exp(-((grid.x_centres[None, :] - 2) ** 2)) * np.ones((grid.ny + 1, 1)))
     hist, nan = ForceHistory(), NaNMonitor(every=200)
     t0 = time.perf_counter()
-    run(sim, t_end, [hist, nan])
+    run(sim, t_end, [hist, nan, ProgressNote(f"cylinder Re {re:g}, D/{ppd}", t_end)])
     wall = time.perf_counter() - t0
     t, f = hist.array()
     cd, cl = 2 * f[:, 0, 0], 2 * f[:, 0, 1]
@@ -174,12 +175,15 @@ def _line_pressure(sim, x_target, side, y_line, body_phi, points=3):
 
 def _march_pair(pair, t_end, label):
     """Step an ``OversetPair`` to t_end like ``run()`` (no shortened last step: a step much shorter
-    than the one before spoils that step's forcing impulse, hence its force); (t, force) series."""
+    than the one before spoils that step's forcing impulse, hence its force); (t, force) series.
+    A progress line on stderr at every tenth of t_end."""
     t, f = [], []
+    note = ProgressNote(f"{label} (overset)", t_end)
     while pair.t < t_end - 1e-12:
         pair.step()
         t.append(pair.t)
         f.append(pair.last_force)
+        note(pair)
         if pair.n_steps % 200 == 0 and not np.isfinite(f[-1]).all():
             raise FloatingPointError(f"{label} overset: non-finite force at t = {pair.t}")
     return np.array(t), np.array(f)
@@ -297,7 +301,8 @@ def dfg(ppd, t_end, threads, scheme, ib_order=1, ny_shift=0, overset=None, body_
         sim.bodies = [ImmersedBody(circle(d), Stationary(0.2, 0.2), grid, sim.L, order=ib_order)]
         sim.set_state(u=u0)
         hist, nan = ForceHistory(), NaNMonitor(every=200)
-        monitors = [hist, nan] + ([ControlVolumeLift(sim, (0.2, 0.2), 1.5 * d)] if cv_lift else [])
+        monitors = [hist, nan, ProgressNote(f"DFG D/{ppd}", t_end)] \
+            + ([ControlVolumeLift(sim, (0.2, 0.2), 1.5 * d)] if cv_lift else [])
         run(sim, t_end, monitors)
         t, f = hist.array()
         f = f[:, 0, :]
@@ -397,7 +402,7 @@ def heave(shape, ppd, re, t_end, window, threads, scheme, overset=None):
         body = sim.add_body(polygon, motion)
         sim.set_state(u=1.0)
         hist, nan = ForceHistory(), NaNMonitor(every=200)
-        run(sim, t_end, [hist, nan])
+        run(sim, t_end, [hist, nan, ProgressNote(f"heave {shape}, h = 1/{ppd}", t_end)])
         t, f = hist.array()
         f = f[:, 0, :]
         inside = body.solid_cells()

@@ -13,7 +13,7 @@ from .bodies import Polygon, box_deck, circle, flat_plate
 from .boundaries import BoundaryConditions
 from .grids import GHOST, CartesianGrid, stretched_faces
 from .immersed import ImmersedBody
-from .monitors import CFLMonitor, DivergenceMonitor, ForceHistory, NaNMonitor, max_divergence, run
+from .monitors import CFLMonitor, DivergenceMonitor, ForceHistory, NaNMonitor, ProgressNote, max_divergence, run
 from .motion import HarmonicMotion, PrescribedMotion, Stationary, UniformTranslation
 from .overset import OversetPair
 from .precision import DTYPE
@@ -24,7 +24,7 @@ from .time_stepping import TIME_SCHEMES, FlowConfig, FlowDiverged, Simulation, S
 __all__ = [
     "BoundaryConditions", "CartesianGrid", "CFLMonitor", "DivergenceMonitor", "DTYPE", "FlowConfig",
     "FlowDiverged", "FlowState", "ForceHistory", "GHOST", "HarmonicMotion", "ImmersedBody", "NaNMonitor",
-    "OversetPair", "PoissonSolver", "Polygon", "PrescribedMotion", "Simulation", "StageHook", "Stationary",
-    "TIME_SCHEMES",
+    "OversetPair", "PoissonSolver", "Polygon", "PrescribedMotion", "ProgressNote", "Simulation", "StageHook",
+    "Stationary", "TIME_SCHEMES",
     "UniformTranslation", "box_deck", "circle", "flat_plate", "max_divergence", "run", "stretched_faces",
 ]

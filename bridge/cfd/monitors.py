@@ -6,6 +6,8 @@ Each monitor has ``__call__(sim)``; ``every`` sets how often it works. ``run`` i
 from __future__ import annotations
 
 import math
+import sys
+import time
 
 import numpy as np
 
@@ -15,7 +17,8 @@ from .grids import GHOST
 from .launch import ROW0
 from .time_stepping import FlowDiverged, Simulation
 
-__all__ = ["ForceHistory", "CFLMonitor", "DivergenceMonitor", "NaNMonitor", "run", "max_divergence"]
+__all__ = ["ForceHistory", "CFLMonitor", "DivergenceMonitor", "NaNMonitor", "ProgressNote", "run",
+           "max_divergence"]
 
 
 class ForceHistory:
@@ -31,6 +34,34 @@ class ForceHistory:
     def array(self) -> tuple[np.ndarray, np.ndarray]:
         """times (n,), forces (n, n_bodies, 3)."""
         return np.array(self.t), np.array(self.forces)
+
+
+class ProgressNote:
+    """Writes a line at every ``fraction`` of the way to ``t_end``: time reached, steps, and the
+    wall time left at the rate so far (to ``stream``, stderr by default). Works with anything that has
+    ``t`` and ``n_steps`` (a ``Simulation`` or an ``OversetPair``)."""
+
+    def __init__(self, label: str, t_end: float, fraction: float = 0.1, stream=None):
+        if not 0 < fraction <= 1:
+            raise ValueError(f"fraction: allowed (0, 1], got {fraction}")
+        self.label, self.t_end, self.fraction = label, float(t_end), fraction
+        self.stream = sys.stderr if stream is None else stream
+        self._start = None   # (wall clock, t) at the first call
+        self._next = None
+
+    def __call__(self, sim) -> None:
+        now = time.perf_counter()
+        if self._start is None:
+            self._start = (now, sim.t)
+            self._next = sim.t + self.fraction * self.t_end
+        if sim.t < self._next:
+            return
+        wall0, t0 = self._start
+        left = (now - wall0) / max(sim.t - t0, 1e-300) * max(self.t_end - sim.t, 0.0)
+        print(f"{self.label}: t = {sim.t:.4g} of {self.t_end:.4g} ({100 * sim.t / self.t_end:.0f} %), "
+              f"{sim.n_steps} steps, about {left:.0f} s left", file=self.stream, flush=True)
+        while self._next <= sim.t:
+            self._next += self.fraction * self.t_end
 
 
 class CFLMonitor:

@@ -1,5 +1,6 @@
 """The CFD tools run end to end with tiny options (speed is not asserted: benchmarks are separate)."""
 
+import io
 import json
 
 import numpy as np
@@ -17,10 +18,27 @@ def test_bench_cfd_runs_tiny(tmp_path):
     assert json.loads(out.read_text())["bytes_per_cell_step"] > 0
 
 
-def test_validate_cfd_runs_tiny(tmp_path):
+def test_progress_note_writes_a_line_per_fraction_with_the_time_left():
+    from types import SimpleNamespace
+
+    from bridge.cfd import ProgressNote
+
+    lines = io.StringIO()
+    note = ProgressNote("case", 2.0, fraction=0.25, stream=lines)
+    for n in range(201):
+        note(SimpleNamespace(t=0.01 * n, n_steps=n))
+    out = lines.getvalue().splitlines()
+    assert len(out) == 4, out   # at t = 0.5, 1, 1.5, 2
+    assert out[0].startswith("case: t = 0.5 of 2 (25 %), 50 steps, about ") and out[-1].endswith(" 0 s left")
+    with pytest.raises(ValueError, match="fraction"):
+        ProgressNote("case", 1.0, fraction=0.0)
+
+
+def test_validate_cfd_runs_tiny(tmp_path, capsys):
     out = tmp_path / "v.jsonl"
     (res,) = load_tool("validate_cfd").main(["dfg", "--ppd", "6", "--t-end", "0.05", "--out", str(out)])
     assert np.isfinite(res["c_D"]) and res["cells"] == 132 * 25  # 2.2 x 0.41 at h = 0.1/6
+    assert "DFG D/6: t = " in capsys.readouterr().err   # progress on stderr
     (res,) = load_tool("validate_cfd").main(["cylinder", "--re", "20", "--ppd", "4", "--t-end", "0.1",
                                              "--out", str(out)])
     assert np.isfinite(res["C_D"])
