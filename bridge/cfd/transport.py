@@ -107,13 +107,14 @@ class TransportedScalar:
     def stable_dt(self, u=None, v=None) -> float:
         """The largest dt for which a step keeps q non-negative and bounded: advection and diffusion
         together, cell by cell, 1 / max(rate_adv / cfl + rate_diff / (2 fourier)) with rate_adv =
-        |u|/dx + |v|/dy and rate_diff = 2 Gamma (1/dx^2 + 1/dy^2) (forward Euler, each stage;
+        |u|/dx + |v|/dy (relative to the grid) and rate_diff = 2 Gamma (1/dx^2 + 1/dy^2) (forward Euler, each stage;
         ``FlowConfig.cfl`` and ``fourier``), for the velocity (u, v) (default: the flow's) and this
         scalar's Gamma."""
         cfg, grid = self.sim.config, self.sim.grid
         g, nx, ny = GHOST, grid.nx, grid.ny
-        u = (self.sim.u if u is None else u).numpy()[g:g + ny, g:g + nx + 1]
-        v = (self.sim.v if v is None else v).numpy()[g:g + ny + 1, g:g + nx]
+        u, v = self.sim.relative_velocity((self.sim.u if u is None else u).numpy()[g:g + ny, g:g + nx + 1],
+                                          (self.sim.v if v is None else v).numpy()[g:g + ny + 1, g:g + nx],
+                                          slice(g, g + ny), slice(g, g + nx))
         dy = grid.dy[:, None]
         adv = np.maximum(np.abs(u[:, :-1]), np.abs(u[:, 1:])) / grid.dx \
             + np.maximum(np.abs(v[:-1]), np.abs(v[1:])) / dy

@@ -171,12 +171,12 @@ class KOmegaSST:
 
     def stable_dt(self) -> float:
         """The transport's limit for k and omega, from each row's largest diffusivity and the largest
-        velocities (cheaper than ``TransportedScalar.stable_dt``'s cell by cell, and no larger)."""
+        velocities relative to the grid (cheaper than ``TransportedScalar.stable_dt``'s cell by cell, and no larger)."""
         cfg, grid, g = self.sim.config, self.sim.grid, GHOST
         rows = slice(g, g + grid.ny), slice(g, g + grid.nx)
         gamma = np.maximum(self.k.gamma.numpy()[rows].max(axis=1), self.omega.gamma.numpy()[rows].max(axis=1))
-        u = self.sim.u.numpy()[rows[0], g:g + grid.nx + 1]
-        v = self.sim.v.numpy()[g:g + grid.ny + 1, rows[1]]
+        u, v = self.sim.relative_velocity(self.sim.u.numpy()[rows[0], g:g + grid.nx + 1],
+                                          self.sim.v.numpy()[g:g + grid.ny + 1, rows[1]], *rows)
         adv = max(u.max(), -u.min()) / grid.dx + max(v.max(), -v.min()) / float(grid.dy.min())
         diff = float(np.max(2.0 * gamma * (1.0 / grid.dx ** 2 + 1.0 / grid.dy ** 2)))
         total = adv / cfg.cfl + diff / (2.0 * cfg.fourier)

@@ -128,9 +128,29 @@ def test_a_grid_moving_with_the_flow_leaves_q_still():
     for _ in range(10):
         q.advance(0.01, u, v)
     np.testing.assert_allclose(q.interior(), start, atol=1e-14)
+    # the time step's limit sees the same relative velocity: none here (no diffusivity: no limit at all)
+    assert q.stable_dt(u, v) == np.inf
     sim.set_frame_velocity(0.0, 0.0, 0.0)
     q.advance(0.01, u, v)
     assert np.abs(q.interior() - start).max() > 1e-3
+    assert np.isclose(q.stable_dt(u, v), sim.config.cfl / (U / grid.dx + V / grid.dy.min()))
+
+
+def test_the_flows_time_step_limit_uses_the_velocity_relative_to_the_grid():
+    """A grid moving with a uniform stream: nothing crosses its cells, so only the viscous limit is
+    left; moving against it, the cells see twice the stream (the absolute velocity, used until
+    2026-12-02, saw once: a step twice too long for the convective limit)."""
+    grid = CartesianGrid.uniform(32, 32, (0.0, 2.0), (0.0, 2.0))
+    sim = Simulation(grid, FlowConfig(nu=1e-3, threads=1, bc=BoundaryConditions(u_inf=U)))  # in- and outflow
+    sim.set_state(u=U, v=0.0)
+    cfg, h = sim.config, grid.dx
+    viscous = cfg.nu / (cfg.fourier * h * h)
+    sim.set_frame_velocity(U, 0.0, 0.0)
+    assert np.isclose(sim.stable_dt(), 1.0 / viscous)
+    sim.set_frame_velocity(-U, 0.0, 0.0)
+    assert np.isclose(sim.stable_dt(), 1.0 / (2 * U / h / cfg.cfl + viscous))
+    sim.set_frame_velocity(0.0, 0.0, 0.0)
+    assert np.isclose(sim.stable_dt(), 1.0 / (U / h / cfg.cfl + viscous))
 
 
 def test_wall_distance_is_exact_to_the_polygons_chords():
