@@ -412,6 +412,10 @@ class OversetPair:
 
     # --- step ---------------------------------------------------------------------------------
     def stable_dt(self) -> float:
+        """The smaller of the grids' (and the model's) limits, the body grid's with the velocity relative
+        to it at the step's start (set here, so that a run resumed from a checkpoint, whose grid has no
+        frame velocity yet, takes the same step as one that was never stopped)."""
+        self.body.set_frame_velocity(*self.frame_velocity(self.t))
         dt = min(self.background.stable_dt(), self.body.stable_dt())
         return dt if self.model is None else min(dt, self.model.stable_dt())
 
