@@ -49,7 +49,7 @@ def cylinder(cells: int, duration: float) -> dict:
     # turned by a fraction of a facet and moved off the grid's mirror line by 0.3 cells: a start that is not
     # mirror-symmetric, so that shedding sets in within a few tens of D/U instead of growing from round-off
     poly = Polygon(poly.vertices @ np.array([[c, s], [-s, c]]) + np.array([0.0, 0.3 / cells]))
-    q = dataclasses.replace(QUICK_UNTIL_2026_12_02, name=f"cylinder D/{cells}", cells_per_chord=cells, dy_over_dx=1.0,
+    q = dataclasses.replace(QUALITY["standard"], name=f"cylinder D/{cells}", cells_per_chord=cells, dy_over_dx=1.0,
                             upstream=8.0, downstream=20.0, half_height=10.0, core_half_height=1.0, reynolds=100.0,
                             static_duration=duration)
     rec = run_case(poly, StaticCase(0.0), q, progress=_say, label=f"cylinder D/{cells}")
