@@ -65,7 +65,8 @@ class ProgressNote:
 
 
 class CFLMonitor:
-    """Records the convective Courant number max(|u| dt/dx + |v| dt/dy) of the state."""
+    """Records the convective Courant number max(|u| dt/dx + |v| dt/dy) of the state, with the velocity
+    relative to the grid (``Simulation.relative_velocity``): what crosses the cells of a moving body grid."""
 
     def __init__(self, every: int = 10, limit: float = 1.0):
         self.every, self.limit, self.history = every, limit, []
@@ -74,6 +75,8 @@ class CFLMonitor:
         if sim.n_steps % self.every:
             return
         u, v, _ = sim.interior()
+        u, v = sim.relative_velocity(u, v, rows=slice(GHOST, GHOST + sim.grid.ny),
+                                     cols=slice(GHOST, GHOST + sim.grid.nx))
         dy = sim.grid.hy_faces()[GHOST:GHOST + sim.grid.ny + 1][:, None]
         dt = sim.last_dt
         c = float(np.abs(u).max() * dt / sim.grid.dx + (np.abs(v) / dy).max() * dt)

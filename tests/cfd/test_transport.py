@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 import warp as wp
 
-from bridge.cfd import BoundaryConditions, CartesianGrid, FlowConfig, Simulation, circle, stretched_faces
+from bridge.cfd import BoundaryConditions, CartesianGrid, CFLMonitor, FlowConfig, Simulation, circle, stretched_faces
 from bridge.cfd.transport import TransportedScalar, advance_pair, wall_distance
 
 U, V = 1.0, 0.5
@@ -151,6 +151,13 @@ def test_the_flows_time_step_limit_uses_the_velocity_relative_to_the_grid():
     assert np.isclose(sim.stable_dt(), 1.0 / (2 * U / h / cfg.cfl + viscous))
     sim.set_frame_velocity(0.0, 0.0, 0.0)
     assert np.isclose(sim.stable_dt(), 1.0 / (U / h / cfg.cfl + viscous))
+    # the CFL monitor reads the same relative velocity: zero on a grid that moves with the stream
+    sim.last_dt = 0.01
+    for frame, courant in ((U, 0.0), (-U, 2 * U * 0.01 / h), (0.0, U * 0.01 / h)):
+        sim.set_frame_velocity(frame, 0.0, 0.0)
+        monitor = CFLMonitor(every=1)
+        monitor(sim)
+        assert np.isclose(monitor.history[-1][1], courant, atol=1e-12)
 
 
 def test_wall_distance_is_exact_to_the_polygons_chords():
