@@ -477,7 +477,7 @@ def run_cases(shape, jobs, quality: Quality, checkpoint_every: int = 2000,
 
 def _march(flow, polys, case, q, checkpoint, checkpoint_every, progress, label) -> ForceRecord:
     """Run ``flow`` to the case's end time, with checkpoints and progress (run_case)."""
-    from bridge.cfd import FlowDiverged, NaNMonitor
+    from bridge.cfd import FlowDiverged, NaNMonitor, ProgressNote
 
     key = case_key(polys, case, q)
     names = ("t", "lift", "drag", "moment", "motion")
@@ -494,8 +494,9 @@ def _march(flow, polys, case, q, checkpoint, checkpoint_every, progress, label) 
                 progress(f"{label}: resuming at t = {flow.t:.2f} (step {resumed}) from {checkpoint}")
     t_end = case.end_time(q)
     nans = [NaNMonitor(every=200) for _ in flow.simulations]
-    t0, t_start = time.perf_counter(), flow.t
-    next_note = flow.t + 0.1 * t_end
+    t0 = time.perf_counter()
+    note = None if not progress else ProgressNote(label, t_end, sink=progress,
+                                                  detail=lambda f: f"{case.progress(f.t, q)}, {f.describe()}")
     while flow.t < t_end - 1e-12 * t_end:
         dt = flow.stable_dt()
         if not (np.isfinite(dt) and dt > 0.0):   # a non-finite velocity makes the limit infinite or NaN
@@ -514,12 +515,8 @@ def _march(flow, polys, case, q, checkpoint, checkpoint_every, progress, label) 
             nan(sim)
         if checkpoint is not None and flow.n_steps % checkpoint_every == 0:
             _save_checkpoint(checkpoint, key, flow, rec)
-        if progress and flow.t >= next_note:
-            done = flow.t / t_end
-            left = (time.perf_counter() - t0) / max(flow.t - t_start, 1e-12) * max(t_end - flow.t, 0.0)
-            progress(f"{label}: t = {flow.t:.1f} of {t_end:.1f} ({100 * done:.0f} %, "
-                     f"{case.progress(flow.t, q)}), {flow.describe()}, about {left:.0f} s left")
-            next_note += 0.1 * t_end
+        if note is not None:
+            note(flow)
     if checkpoint is not None:
         _save_checkpoint(checkpoint, key, flow, rec)
     arrays = {n: np.asarray(v, dtype=np.float64) for n, v in rec.items()}

@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 import sys
 import time
+from collections.abc import Callable
 
 import numpy as np
 
@@ -37,15 +38,21 @@ class ForceHistory:
 
 
 class ProgressNote:
-    """Writes a line at every ``fraction`` of the way to ``t_end``: time reached, steps, and the
-    wall time left at the rate so far (to ``stream``, stderr by default). Works with anything that has
-    ``t`` and ``n_steps`` (a ``Simulation`` or an ``OversetPair``)."""
+    """Writes a line at every ``fraction`` of the way to ``t_end``: time reached, steps, ``detail(sim)`` if
+    given, and the wall time left at the rate so far - to ``sink`` (a callable taking the line) if given,
+    else to ``stream`` (stderr by default). Works with anything that has ``t`` and ``n_steps`` (a
+    ``Simulation`` or an ``OversetPair``); the rate counts from the first call, so a resumed run's
+    estimate is not skewed by the time it did not spend."""
 
-    def __init__(self, label: str, t_end: float, fraction: float = 0.1, stream=None):
+    def __init__(self, label: str, t_end: float, fraction: float = 0.1, stream=None,
+                 sink: Callable[[str], None] | None = None, detail: Callable[[object], str] | None = None):
         if not 0 < fraction <= 1:
             raise ValueError(f"fraction: allowed (0, 1], got {fraction}")
-        self.label, self.t_end, self.fraction = label, float(t_end), fraction
-        self.stream = sys.stderr if stream is None else stream
+        self.label, self.t_end, self.fraction, self.detail = label, float(t_end), fraction, detail
+        if sink is None:
+            out = sys.stderr if stream is None else stream
+            sink = lambda line: print(line, file=out, flush=True)  # noqa: E731
+        self.sink = sink
         self._start = None   # (wall clock, t) at the first call
         self._next = None
 
@@ -58,8 +65,9 @@ class ProgressNote:
             return
         wall0, t0 = self._start
         left = (now - wall0) / max(sim.t - t0, 1e-300) * max(self.t_end - sim.t, 0.0)
-        print(f"{self.label}: t = {sim.t:.4g} of {self.t_end:.4g} ({100 * sim.t / self.t_end:.0f} %), "
-              f"{sim.n_steps} steps, about {left:.0f} s left", file=self.stream, flush=True)
+        extra = f"{self.detail(sim)}, " if self.detail is not None else ""
+        self.sink(f"{self.label}: t = {sim.t:.4g} of {self.t_end:.4g} ({100 * sim.t / self.t_end:.0f} %), "
+                  f"{sim.n_steps} steps, {extra}about {left:.0f} s left")
         while self._next <= sim.t:
             self._next += self.fraction * self.t_end
 

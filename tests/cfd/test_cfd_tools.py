@@ -32,6 +32,12 @@ def test_progress_note_writes_a_line_per_fraction_with_the_time_left():
     assert out[0].startswith("case: t = 0.5 of 2 (25 %), 50 steps, about ") and out[-1].endswith(" 0 s left")
     with pytest.raises(ValueError, match="fraction"):
         ProgressNote("case", 1.0, fraction=0.0)
+    # the aero stage's form: lines to a callable, with the case's own detail before the time left
+    said = []
+    note = ProgressNote("heave", 1.0, fraction=0.5, sink=said.append, detail=lambda sim: f"{sim.n_steps // 10} periods")
+    for n in range(11):
+        note(SimpleNamespace(t=0.1 * n, n_steps=n))
+    assert len(said) == 2 and said[0].startswith("heave: t = 0.5 of 1 (50 %), 5 steps, 0 periods, about ")
 
 
 def test_validate_cfd_runs_tiny(tmp_path, capsys):
