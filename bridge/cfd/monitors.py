@@ -49,12 +49,13 @@ class ProgressNote:
         if not 0 < fraction <= 1:
             raise ValueError(f"fraction: allowed (0, 1], got {fraction}")
         self.label, self.t_end, self.fraction, self.detail = label, float(t_end), fraction, detail
-        if sink is None:
-            out = sys.stderr if stream is None else stream
-            sink = lambda line: print(line, file=out, flush=True)  # noqa: E731
-        self.sink = sink
+        self.stream = sys.stderr if stream is None else stream
+        self.sink = self._print if sink is None else sink
         self._start = None   # (wall clock, t) at the first call
         self._next = None
+
+    def _print(self, line: str) -> None:
+        print(line, file=self.stream, flush=True)
 
     def __call__(self, sim) -> None:
         now = time.perf_counter()
