@@ -60,11 +60,9 @@ def _sheet_on_points(xc: np.ndarray, X: np.ndarray, f: np.ndarray) -> np.ndarray
     return (f0[None, :] * log + slope[None, :] * ((X1 - X0)[None, :] - d0 * log)).sum(axis=1) / (2 * math.pi)
 
 
-def thin_plate_heave(K: float, wake_speed=None, wake_gain=None, panels: int = 400,
-                     length: float = 200.0) -> dict:
-    """H1*, H4*, A1*, A4* of a heaving plate (chord 1 from -0.5 to 0.5, U = 1, omega = K) whose wake travels
-    at ``wake_speed(x)`` (default U) with its Kelvin density scaled by ``wake_gain(x)`` (default 1); the wake
-    is ``length`` chords long, tapered over its last fifth."""
+def _heaving_plate(K: float, wake_speed, wake_gain, panels: int, length: float):
+    """The model's solution per unit plate velocity hdot (up): vortex and panel-centre positions and each
+    panel's lift, steady (at the vortex) and unsteady (at the centre) parts (rho = U = 1)."""
     edges = np.linspace(-0.5, 0.5, panels + 1)
     dc = np.diff(edges)
     xv, xc, xm = edges[:-1] + 0.25 * dc, edges[:-1] + 0.75 * dc, edges[:-1] + 0.5 * dc
@@ -80,12 +78,27 @@ def thin_plate_heave(K: float, wake_speed=None, wake_gain=None, panels: int = 40
     taper = np.where(s > 0.8 * length, np.cos(0.5 * math.pi * (s - 0.8 * length) / (0.2 * length)) ** 2, 1.0)
     matrix = bound + _sheet_on_points(xc, X, density * taper)[:, None]
     gamma = np.linalg.solve(matrix, np.ones(panels, dtype=complex))   # plate velocity hdot = 1 (up)
-    steady, unsteady = gamma, 1j * K * dc * np.cumsum(gamma)           # rho = U = 1
+    return xv, xm, dc, gamma, 1j * K * dc * np.cumsum(gamma)           # Katz & Plotkin's pressure jump
+
+
+def thin_plate_heave(K: float, wake_speed=None, wake_gain=None, panels: int = 400,
+                     length: float = 200.0) -> dict:
+    """H1*, H4*, A1*, A4* of a heaving plate (chord 1 from -0.5 to 0.5, U = 1, omega = K) whose wake travels
+    at ``wake_speed(x)`` (default U) with its Kelvin density scaled by ``wake_gain(x)`` (default 1); the wake
+    is ``length`` chords long, tapered over its last fifth."""
+    xv, xm, _, steady, unsteady = _heaving_plate(K, wake_speed, wake_gain, panels, length)
     lift = steady.sum() + unsteady.sum()                                # up
     moment = -(steady * xv).sum() - (unsteady * xm).sum()              # nose-up, about mid-chord
     per_h_lift, per_h_moment = lift * 1j * K, -moment * 1j * K         # per unit h down (L down, M nose-up)
     return {"H1": 2 * per_h_lift.imag / K**2, "H4": 2 * per_h_lift.real / K**2,
             "A1": 2 * per_h_moment.imag / K**2, "A4": 2 * per_h_moment.real / K**2}
+
+
+def thin_plate_loading(K: float, panels: int = 400) -> tuple[np.ndarray, np.ndarray, complex]:
+    """Theodorsen's problem in the model: panel centres, the pressure jump (lift per chord, up) there and the
+    lift, all per unit plate velocity hdot (up), first harmonics."""
+    _, xm, dc, steady, unsteady = _heaving_plate(K, None, None, panels, 200.0)
+    return xm, (steady + unsteady) / dc, complex(steady.sum() + unsteady.sum())
 
 
 # ----------------------------------------------------------------------------------------------------------
@@ -94,9 +107,7 @@ def thin_plate_heave(K: float, wake_speed=None, wake_gain=None, panels: int = 40
 def wake_harmonic(t: np.ndarray, x: np.ndarray, circulation: np.ndarray, K: float) -> tuple[np.ndarray, np.ndarray]:
     """First harmonic Gamma_1(x) of ``circulation`` (samples x columns; circulation ~ Re(Gamma_1 e^{iKt}))
     by least squares over the samples, and the speed c(x) = -K / (d arg Gamma_1 / dx) at which it travels."""
-    basis = np.column_stack([np.ones_like(t), np.cos(K * t), np.sin(K * t)])
-    coef = np.linalg.lstsq(basis, circulation, rcond=None)[0]
-    first = coef[1] - 1j * coef[2]
+    first = _harmonic(t, circulation, K)
     return first, -K / np.gradient(np.unwrap(np.angle(first)), x)
 
 
@@ -119,7 +130,15 @@ def sample_wake(reduced_velocity: float, quality: str, grid: str, periods: int =
     xc, yc = np.asarray(fixed.grid.x_centres), np.asarray(fixed.grid.y_centres)
     cols, rows = np.where((xc > 0.7) & (xc < 7.5))[0], np.where(np.abs(yc) < 1.5)[0]
     dy = np.gradient(yc)[rows]
-    times, columns, record = [], [], []
+    # overset: the pressure jump across the plate, p on the second fluid row below minus above (the body grid
+    # moves with the plate, so the rows stay put; the single grid's plate crosses its rows: not sampled)
+    body = getattr(flow, "body", None)
+    if body is not None:
+        bx, by = np.asarray(body.grid.x_centres), np.asarray(body.grid.y_centres)
+        off = 0.01 + 1.5 * (by[1] - by[0])
+        above, below = int(np.argmin(np.abs(by - off))), int(np.argmin(np.abs(by + off)))
+        chord = np.where(np.abs(bx) < 0.5)[0]
+    times, columns, jumps, record = [], [], [], []
     next_sample, t0, reported = 3 * T, time.perf_counter(), 0
     while flow.t < periods * T:
         flow.step(flow.stable_dt())
@@ -131,6 +150,9 @@ def sample_wake(reduced_velocity: float, quality: str, grid: str, periods: int =
             vc = 0.5 * (v[g:g + ny, g:g + nx] + v[g + 1:g + ny + 1, g:g + nx])
             vort = np.gradient(vc, xc, axis=1) - np.gradient(uc, yc, axis=0)
             columns.append((vort[np.ix_(rows, cols)] * dy[:, None]).sum(axis=0))
+            if body is not None:
+                p = body.p.numpy()
+                jumps.append(p[g + below, g + chord] - p[g + above, g + chord])
             times.append(flow.t)
             next_sample += T / 32
         if int(10 * flow.t / (periods * T)) > reported:
@@ -138,7 +160,29 @@ def sample_wake(reduced_velocity: float, quality: str, grid: str, periods: int =
             say(f"U/(fB) = {reduced_velocity:g} heave: t = {flow.t:.2f} of {periods * T:.2f} ({10 * reported} %), "
                 f"{time.perf_counter() - t0:.0f} s")
     return {"K": K, "T": T, "t": np.array(times), "x": xc[cols], "circulation": np.array(columns),
-            "record": np.array(record), "cells": flow.describe()}
+            "record": np.array(record), "cells": flow.describe(),
+            "jump": np.array(jumps) if body is not None else None, "jump_x": bx[chord] if body is not None else None}
+
+
+def _harmonic(t: np.ndarray, y: np.ndarray, K: float):
+    """First harmonic Y_1 of y ~ Re(Y_1 e^{iKt}) + mean, least squares (y: samples or samples x columns)."""
+    basis = np.column_stack([np.ones_like(t), np.cos(K * t), np.sin(K * t)])
+    coef = np.linalg.lstsq(basis, y, rcond=None)[0]
+    return coef[1] - 1j * coef[2]
+
+
+def loading_against_theodorsen(sample: dict, panels: int = 400) -> dict:
+    """The sampled pressure jump's first harmonic per unit plate velocity against the model's Theodorsen
+    loading at the same x, and the lift from the forces against the model's lift."""
+    K, T = sample["K"], sample["T"]
+    t, lift, _, h = sample["record"].T
+    keep = t >= 3 * T - 1e-9
+    hdot = 1j * K * _harmonic(t[keep], h[keep], K)
+    jump = _harmonic(sample["t"], sample["jump"], K) / hdot
+    xm, model, model_lift = thin_plate_loading(K, panels)
+    ref = np.interp(sample["jump_x"], xm, model.real) + 1j * np.interp(sample["jump_x"], xm, model.imag)
+    return {"x": sample["jump_x"], "ratio": jump / ref,
+            "lift_ratio": complex(_harmonic(t[keep], lift[keep], K) / hdot / model_lift)}
 
 
 def cfd_heave_derivatives(sample: dict) -> dict:
@@ -196,6 +240,16 @@ def main(argv=None) -> list[dict]:
                       "model_growth": (grown[n] - base[n]) / abs(base[n])}
             print(f"  {n}* | {100 * row[n]['cfd_miss']:+.1f} % | {100 * row[n]['model_speed']:+.1f} % | "
                   f"{100 * row[n]['model_growth']:+.1f} %")
+        if s["jump"] is not None:
+            load = loading_against_theodorsen(s, a.panels)
+            at = [-0.35, -0.25, -0.1, 0.0, 0.1, 0.25, 0.35, 0.45]
+            ratios = [load["ratio"][int(np.argmin(np.abs(load["x"] - xi)))] for xi in at]
+            row["loading"] = {"x": at, "ratio_re": [r.real for r in ratios], "ratio_im": [r.imag for r in ratios],
+                              "lift_ratio": [load["lift_ratio"].real, load["lift_ratio"].imag]}
+            print(f"  pressure jump / Theodorsen's (first harmonics, 1.5 cells off the plate; lift from the forces "
+                  f"/ Theodorsen's: {load['lift_ratio']:.3f}):")
+            print("  " + ", ".join(f"x {xi:+.2f}: {abs(r):.2f} ({math.degrees(np.angle(r)):+.0f} deg)"
+                                   for xi, r in zip(at, ratios, strict=True)))
         rows.append(row)
     a.out.mkdir(parents=True, exist_ok=True)
     (a.out / "plate_wake.json").write_text(json.dumps(rows, indent=1))

@@ -323,6 +323,19 @@ def _write_multimode(g: Any, mm: MultimodeResult, which: str) -> None:
                       "wind speeds of those points, one per unresolved_mode entry")
 
 
+def _pk_coverage(m: MultimodeResult) -> list[str]:
+    """'MODE a-b m/s' for each p-k mode whose damping the aerodynamic data leave out at the low or the high end
+    of the speeds searched (isolated gaps inside are the unresolved points, reported apart)."""
+    out = []
+    for i, lab in enumerate(m.labels):
+        v = m.speed_m_s[np.isfinite(m.damping_ratio[:, i])]
+        if v.size == 0:
+            out.append(f"{lab} at no speed searched")
+        elif v[0] > m.speed_m_s[0] or v[-1] < m.speed_m_s[-1]:
+            out.append(f"{lab} {v[0]:.1f}-{v[-1]:.1f} m/s")
+    return out
+
+
 def _report(d: FlutterStageResult, source: str, fopts: FlutterOptions) -> str:
     lines = ["## Flutter", "",
              f"Modes from the {source}; {d.aerodynamics} aerodynamics; air density {d.air_density_kg_m3:g} kg/m^3; "
@@ -371,6 +384,10 @@ def _report(d: FlutterStageResult, source: str, fopts: FlutterOptions) -> str:
             f"first zero damping at V = {m.critical_speed_m_s:.2f} m/s in mode {m.unstable_mode} "
             f"(f = {m.frequency_hz_at_flutter:.4f} Hz)." if m.flutter
             else f"no damping ratio of an oscillating mode crosses zero below {m.max_speed_searched_m_s:g} m/s.")]
+        covered = _pk_coverage(m)
+        if covered:
+            lines.append("Damping computed only where the aerodynamic data cover the mode's frequency (Omega inside "
+                         "the table; elsewhere NaN, and a crossing there cannot be found): " + "; ".join(covered) + ".")
         if not math.isnan(m.divergence_speed_m_s):
             lines.append(f"Static divergence (frequency to zero) at V = {m.divergence_speed_m_s:.2f} m/s.")
         real = [lab for i, lab in enumerate(m.labels) if not m.oscillatory[:, i].all()]

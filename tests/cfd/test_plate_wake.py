@@ -50,3 +50,4 @@ def test_plate_wake_tool_runs_tiny(tmp_path, capsys):
     saved = json.loads((tmp_path / "plate_wake.json").read_text())
     assert saved[0]["reduced_velocity"] == 4.0 and set(saved[0]["H1"]) >= {"cfd", "model_speed", "model_growth"}
     assert (tmp_path / "plate_wake.png").stat().st_size > 0 and rows[0]["wake_speed_mean"] > 0
+    assert len(saved[0]["loading"]["ratio_re"]) == len(saved[0]["loading"]["x"])   # the overset pair's p jump

@@ -166,6 +166,12 @@ def test_a_pair_without_a_root_in_the_table_does_not_stop_the_stage(tmp_path):
     lo = 31.0 * 2 * np.pi * 0.3 / 0.6          # below B w_T / K_max the data miss the torsional frequency
     assert f"* SS-V1+SS-T1 (0.2000-0.3000 Hz): 1.5-{lo:.1f} m/s" in rep
     assert "the lowest root found" in rep
+    # and the p-k says from which speed on each mode's damping could be computed at all
+    mm = out.data.multimode
+    i = mm.labels.index("SS-T1")
+    first = mm.speed_m_s[np.isfinite(mm.damping_ratio[:, i])][0]
+    assert first > mm.speed_m_s[0] and abs(first - lo) < 2 * (mm.speed_m_s[1] - mm.speed_m_s[0]) + 0.1 * lo
+    assert f"SS-T1 {first:.1f}-" in rep.split("Damping computed only where the aerodynamic data cover")[1]
 
 
 # ------------------------------------------------------------------------------ columns
