@@ -9,7 +9,9 @@ keeps its strength.  This tool measures both in the CFD: it runs the heave case 
 aero stage's grids, samples the vorticity of the fixed grid every 1/32 period, integrates it across the wake
 (|y| < 1.5 chords) and fits the first harmonic of that circulation per unit length, Gamma_1(x), at every
 column 0.2-7 chords behind the trailing edge.  Its phase gives the speed at which the shed vorticity travels,
-c(x) = -omega / (d arg Gamma_1 / dx), its modulus how the wake amplifies or damps it.
+c(x) = -omega / (d arg Gamma_1 / dx), its modulus how the wake amplifies or damps it.  On the overset pair it
+also samples the pressure jump across the plate (1.5 cells off it, on the body grid) and compares its first
+harmonic with Theodorsen's chordwise loading from the model below.
 
 The model (``thin_plate_heave``): the plate as N lumped vortices (quarter-panel vortices, three-quarter-panel
 collocation), a continuous wake sheet from the trailing edge whose density follows Kelvin's theorem and travels
