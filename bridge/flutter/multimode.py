@@ -238,6 +238,11 @@ def pk_sweep(model: ModalModel, aero: AerodynamicModel, air_density: float, max_
         eig[n], shapes[n], outside[n] = s_new, phi_new, off
     zeta = np.where(outside, np.nan, _damping(eig))        # NaN: outside the aerodynamic model's range
     freq = np.where(outside, np.nan, eig.imag / (2 * np.pi))
+    # a root whose frequency is round-off (below 1e-6 of the sweep's highest, MultimodeResult.oscillatory) is
+    # real: frequency exactly 0 and zeta exactly +-1, whatever the last bits of its imaginary part
+    real = np.isfinite(freq) & (np.abs(freq) <= 1e-6 * np.nan_to_num(np.abs(freq), nan=0.0).max(initial=0.0))
+    zeta = np.where(real, np.sign(zeta), zeta)
+    freq = np.where(real, 0.0, freq)
     result = dict(labels=model.labels, speed_m_s=speeds, frequency_hz=freq, damping_ratio=zeta,
                   max_speed_searched_m_s=float(v_hi), unresolved=tuple(unresolved))
     crossing = np.flatnonzero((zeta[:-1] > 0.0) & (zeta[1:] <= 0.0))  # flat index over (n_V-1, N)
