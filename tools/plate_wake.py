@@ -137,8 +137,9 @@ def sample_wake(reduced_velocity: float, quality: str, grid: str, periods: int =
     body = getattr(flow, "body", None)
     if body is not None:
         bx, by = np.asarray(body.grid.x_centres), np.asarray(body.grid.y_centres)
-        off = 0.01 + 1.5 * (by[1] - by[0])
-        above, below = int(np.argmin(np.abs(by - off))), int(np.argmin(np.abs(by + off)))
+        above, below = (int(np.argmin(np.abs(by - y))) for y in (0.01 + 1.5 * (by[1] - by[0]),
+                                                                   -0.01 - 1.5 * (by[1] - by[0])))
+        gap = 0.5 * (by[above] - by[below]) - 0.01   # row to surface: the jump there is 2 gap rho hddot larger
         chord = np.where(np.abs(bx) < 0.5)[0]
     times, columns, jumps, record = [], [], [], []
     next_sample, t0, reported = 3 * T, time.perf_counter(), 0
@@ -161,9 +162,13 @@ def sample_wake(reduced_velocity: float, quality: str, grid: str, periods: int =
             reported = int(10 * flow.t / (periods * T))
             say(f"U/(fB) = {reduced_velocity:g} heave: t = {flow.t:.2f} of {periods * T:.2f} ({10 * reported} %), "
                 f"{time.perf_counter() - t0:.0f} s")
+    whole = np.array(times) < periods * T - T / 64   # 32 samples a period over whole periods, no end sample twice
+    times, columns = list(np.array(times)[whole]), list(np.array(columns)[whole])
+    jumps = list(np.array(jumps)[whole]) if jumps else jumps
     return {"K": K, "T": T, "t": np.array(times), "x": xc[cols], "circulation": np.array(columns),
             "record": np.array(record), "cells": flow.describe(),
-            "jump": np.array(jumps) if body is not None else None, "jump_x": bx[chord] if body is not None else None}
+            "jump": np.array(jumps) if body is not None else None, "jump_x": bx[chord] if body is not None else None,
+            "jump_gap": gap if body is not None else None}
 
 
 def _harmonic(t: np.ndarray, y: np.ndarray, K: float):
@@ -180,11 +185,13 @@ def loading_against_theodorsen(sample: dict, panels: int = 400) -> dict:
     t, lift, _, h = sample["record"].T
     keep = t >= 3 * T - 1e-9
     hdot = 1j * K * _harmonic(t[keep], h[keep], K)
-    jump = _harmonic(sample["t"], sample["jump"], K) / hdot
+    # the fluid between the sampled rows and the surfaces accelerates with the plate: dp/dy = -rho hddot there
+    jump = _harmonic(sample["t"], sample["jump"], K) / hdot - 2 * sample["jump_gap"] * 1j * K
     xm, model, model_lift = thin_plate_loading(K, panels)
     ref = np.interp(sample["jump_x"], xm, model.real) + 1j * np.interp(sample["jump_x"], xm, model.imag)
-    return {"x": sample["jump_x"], "ratio": jump / ref,
-            "lift_ratio": complex(_harmonic(t[keep], lift[keep], K) / hdot / model_lift)}
+    cfd_lift = _harmonic(t[keep], lift[keep], K) / hdot
+    return {"x": sample["jump_x"], "ratio": jump / ref, "lift_ratio": complex(cfd_lift / model_lift),
+            "jump_integral_over_lift": complex(np.trapezoid(jump, sample["jump_x"]) / cfd_lift)}
 
 
 def cfd_heave_derivatives(sample: dict) -> dict:
@@ -219,7 +226,7 @@ def main(argv=None) -> list[dict]:
         K = s["K"]
         first, speed = wake_harmonic(s["t"], s["x"], s["circulation"], K)
         x = s["x"]
-        mean_speed = float(np.mean(speed))
+        mean_speed = float(-K / np.polyfit(x, np.unwrap(np.angle(first)), 1)[0])   # one line through the phase
         gain = np.abs(first) / np.abs(first[0])
         ref = derivatives_from_frf(np.array([K]), Theodorsen().frf(np.array([K]), 1.0))
         theo = {n: float(np.asarray(getattr(ref, n))[0]) for n in HEAVE}
@@ -247,9 +254,11 @@ def main(argv=None) -> list[dict]:
             at = [-0.35, -0.25, -0.1, 0.0, 0.1, 0.25, 0.35, 0.45]
             ratios = [load["ratio"][int(np.argmin(np.abs(load["x"] - xi)))] for xi in at]
             row["loading"] = {"x": at, "ratio_re": [r.real for r in ratios], "ratio_im": [r.imag for r in ratios],
-                              "lift_ratio": [load["lift_ratio"].real, load["lift_ratio"].imag]}
+                              "lift_ratio": [load["lift_ratio"].real, load["lift_ratio"].imag],
+                              "jump_integral_over_lift": abs(load["jump_integral_over_lift"])}
             print(f"  pressure jump / Theodorsen's (first harmonics, 1.5 cells off the plate; lift from the forces "
-                  f"/ Theodorsen's: {load['lift_ratio']:.3f}):")
+                  f"/ Theodorsen's: {load['lift_ratio']:.3f}; the sampled jump integrates to "
+                  f"{100 * abs(load['jump_integral_over_lift']):.0f} % of the lift from the forces):")
             print("  " + ", ".join(f"x {xi:+.2f}: {abs(r):.2f} ({math.degrees(np.angle(r)):+.0f} deg)"
                                    for xi, r in zip(at, ratios, strict=True)))
         rows.append(row)

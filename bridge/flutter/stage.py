@@ -324,15 +324,22 @@ def _write_multimode(g: Any, mm: MultimodeResult, which: str) -> None:
 
 
 def _pk_coverage(m: MultimodeResult) -> list[str]:
-    """'MODE a-b m/s' for each p-k mode whose damping the aerodynamic data leave out at the low or the high end
-    of the speeds searched (isolated gaps inside are the unresolved points, reported apart)."""
+    """'MODE a-b m/s[, c-d m/s]' for each p-k mode whose damping the aerodynamic data leave out at some of the
+    speeds searched: the stretches where it was computed.  A single missing point between two computed ones
+    is an unresolved point (reported apart), not a gap in the data."""
     out = []
+    v = m.speed_m_s
     for i, lab in enumerate(m.labels):
-        v = m.speed_m_s[np.isfinite(m.damping_ratio[:, i])]
-        if v.size == 0:
+        ok = np.isfinite(m.damping_ratio[:, i])
+        ok[1:-1] |= ok[:-2] & ok[2:]
+        if ok.all():
+            continue
+        if not ok.any():
             out.append(f"{lab} at no speed searched")
-        elif v[0] > m.speed_m_s[0] or v[-1] < m.speed_m_s[-1]:
-            out.append(f"{lab} {v[0]:.1f}-{v[-1]:.1f} m/s")
+            continue
+        edges = np.flatnonzero(np.diff(np.concatenate([[0], ok.astype(np.int8), [0]])))
+        out.append(f"{lab} " + ", ".join(f"{v[a]:.1f}-{v[b - 1]:.1f} m/s" for a, b in zip(edges[::2], edges[1::2],
+                                                                                            strict=True)))
     return out
 
 
