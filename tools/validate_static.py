@@ -2,7 +2,7 @@
 
     python tools/validate_static.py cylinder [--cells 16 24] [--duration 150]
     python tools/validate_static.py plate [--cells 24 40] [--thickness 0.02] [--plate-domain preset --quality standard]
-                                  [--upstream 8 --half-height 16]
+                                  [--upstream 8 --half-height 16] [--reynolds 2000]
     python tools/validate_static.py section --section rectangle [--quality quick]
 
 ``cylinder``: circular cylinder at Re = 100, held still, through the same code as a deck section
@@ -85,6 +85,7 @@ def main(argv=None) -> int:
                     help="plate: the 2 / 10 / 2 chord domain of the earlier runs in docs/aero.md, or --quality's")
     ap.add_argument("--upstream", type=float, default=None, help="plate: chords upstream (default: the domain's)")
     ap.add_argument("--half-height", type=float, default=None, help="plate: chords to each side (default: domain's)")
+    ap.add_argument("--reynolds", type=float, default=None, help="plate: Reynolds number (default: the preset's)")
     ap.add_argument("--out", type=Path, default=None)
     args = ap.parse_args(argv)
     t0 = time.perf_counter()
@@ -104,7 +105,8 @@ def main(argv=None) -> int:
             base = QUICK_UNTIL_2026_12_02 if args.plate_domain == "old-quick" else QUALITY[args.quality]
             q = dataclasses.replace(base, name=f"plate {n}/chord", cells_per_chord=n,
                                     upstream=base.upstream if args.upstream is None else args.upstream,
-                                    half_height=base.half_height if args.half_height is None else args.half_height)
+                                    half_height=base.half_height if args.half_height is None else args.half_height,
+                                    reynolds=base.reynolds if args.reynolds is None else args.reynolds)
             r = sweep(poly, args.thickness, q)
             rows.append({"case": "plate", "cells_per_chord": n, **r})
             (_, dcl), (_, dcm) = r["fits"]["lift"], r["fits"]["moment"]
