@@ -40,6 +40,7 @@ from validate_aero import plate_quality  # noqa: E402
 
 from bridge.aero.forced_motion import ForcedCase, _overset_flow, _SingleGridFlow  # noqa: E402
 from bridge.aero.frequency_response import forced_motion_response  # noqa: E402
+from bridge.aero.snapshots import cell_centred  # noqa: E402
 from bridge.aero.stage import _unit_polygon  # noqa: E402
 from bridge.cfd.grids import GHOST  # noqa: E402
 from bridge.cfd.sections import FlatPlate  # noqa: E402
@@ -128,7 +129,7 @@ def sample_wake(reduced_velocity: float, quality: str, grid: str, periods: int =
     case = ForcedCase.thesis("heave", K)
     flow = _overset_flow(q, polys, case, None) if q.overset else _SingleGridFlow(q, polys, case, None)
     fixed = flow.simulations[0]
-    g, nx, ny = GHOST, fixed.grid.nx, fixed.grid.ny
+    g = GHOST
     xc, yc = np.asarray(fixed.grid.x_centres), np.asarray(fixed.grid.y_centres)
     cols, rows = np.where((xc > 0.7) & (xc < 7.5))[0], np.where(np.abs(yc) < 1.5)[0]
     dy = np.gradient(yc)[rows]
@@ -148,10 +149,7 @@ def sample_wake(reduced_velocity: float, quality: str, grid: str, periods: int =
         fx, fy, mz = flow.last_force
         record.append((flow.t, fy, -mz, case.displacement(flow.t)))
         if flow.t >= next_sample:
-            u, v = fixed.u.numpy(), fixed.v.numpy()
-            uc = 0.5 * (u[g:g + ny, g:g + nx] + u[g:g + ny, g + 1:g + nx + 1])
-            vc = 0.5 * (v[g:g + ny, g:g + nx] + v[g + 1:g + ny + 1, g:g + nx])
-            vort = np.gradient(vc, xc, axis=1) - np.gradient(uc, yc, axis=0)
+            vort = cell_centred(fixed.grid, fixed.u.numpy(), fixed.v.numpy())[2]
             columns.append((vort[np.ix_(rows, cols)] * dy[:, None]).sum(axis=0))
             if body is not None:
                 p = body.p.numpy()

@@ -103,10 +103,9 @@ def main(argv=None) -> int:
         for n in args.cells or [24, 40]:
             # the domain and run length of the earlier runs in docs/aero.md, or the preset's (its grid, n cells)
             base = QUICK_UNTIL_2026_12_02 if args.plate_domain == "old-quick" else QUALITY[args.quality]
+            given = {"upstream": args.upstream, "half_height": args.half_height, "reynolds": args.reynolds}
             q = dataclasses.replace(base, name=f"plate {n}/chord", cells_per_chord=n,
-                                    upstream=base.upstream if args.upstream is None else args.upstream,
-                                    half_height=base.half_height if args.half_height is None else args.half_height,
-                                    reynolds=base.reynolds if args.reynolds is None else args.reynolds)
+                                    **{k: v for k, v in given.items() if v is not None})
             r = sweep(poly, args.thickness, q)
             rows.append({"case": "plate", "cells_per_chord": n, **r})
             (_, dcl), (_, dcm) = r["fits"]["lift"], r["fits"]["moment"]

@@ -15,7 +15,18 @@ import math
 
 import numpy as np
 
-__all__ = ["flow_snapshot", "snapshot_files"]
+__all__ = ["cell_centred", "flow_snapshot", "snapshot_files"]
+
+
+def cell_centred(grid, u: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Cell-centred u, v (ny, nx) of the staggered storage arrays (ghosts included) and the vorticity
+    dv/dx - du/dy by second-order differences on the (stretched) grid."""
+    from bridge.cfd.grids import GHOST as g
+
+    nx, ny = grid.nx, grid.ny
+    uc = 0.5 * (u[g:g + ny, g:g + nx] + u[g:g + ny, g + 1:g + nx + 1])
+    vc = 0.5 * (v[g:g + ny, g:g + nx] + v[g + 1:g + ny + 1, g:g + nx])
+    return uc, vc, np.gradient(vc, grid.x_centres, axis=1) - np.gradient(uc, grid.y_centres, axis=0)
 
 
 def flow_snapshot(grid, u: np.ndarray, v: np.ndarray, p: np.ndarray, polygons, pose, t: float) -> dict:
@@ -25,12 +36,9 @@ def flow_snapshot(grid, u: np.ndarray, v: np.ndarray, p: np.ndarray, polygons, p
 
     from bridge.cfd.grids import GHOST as g
 
-    nx, ny = grid.nx, grid.ny
-    uc = 0.5 * (u[g:g + ny, g:g + nx] + u[g:g + ny, g + 1:g + nx + 1])
-    vc = 0.5 * (v[g:g + ny, g:g + nx] + v[g + 1:g + ny + 1, g:g + nx])
-    pc = np.array(p[g:g + ny, g:g + nx], dtype=float)
+    uc, vc, vort = cell_centred(grid, u, v)
+    pc = np.array(p[g:g + grid.ny, g:g + grid.nx], dtype=float)
     xc, yc = grid.x_centres, grid.y_centres
-    vort = np.gradient(vc, xc, axis=1) - np.gradient(uc, yc, axis=0)
     c, s = math.cos(pose[2]), math.sin(pose[2])
     X, Y = np.meshgrid(xc, yc)
     points = np.column_stack([X.ravel(), Y.ravel()])

@@ -30,6 +30,8 @@ from bridge.flutter.aerodynamics import AerodynamicModel
 from bridge.flutter.determinant import _aero_bracket, speed_window
 from bridge.flutter.modal import ModalModel
 
+_ROUND_OFF_FREQUENCY = 1e-6   # a p-k frequency below this fraction of the sweep's highest is a real root
+
 __all__ = ["MultimodeResult", "pk_sweep", "aeroelastic_eigenvalues", "static_divergence_speed"]
 
 
@@ -66,7 +68,7 @@ class MultimodeResult:
         exactly +1 (a decaying real root: aerodynamic damping above critical) or -1 (a growing real
         root: static divergence), not a damping ratio of an oscillation."""
         f = np.nan_to_num(self.frequency_hz, nan=0.0)
-        return f > 1e-6 * f.max(initial=0.0)
+        return f > _ROUND_OFF_FREQUENCY * f.max(initial=0.0)
 
 
 def _state_matrix(model: ModalModel, aero: AerodynamicModel, rho: float, w: float, V: float) -> np.ndarray:
@@ -240,7 +242,7 @@ def pk_sweep(model: ModalModel, aero: AerodynamicModel, air_density: float, max_
     freq = np.where(outside, np.nan, eig.imag / (2 * np.pi))
     # a root whose frequency is round-off (below 1e-6 of the sweep's highest, MultimodeResult.oscillatory) is
     # real: frequency exactly 0 and zeta exactly +-1, whatever the last bits of its imaginary part
-    real = np.isfinite(freq) & (np.abs(freq) <= 1e-6 * np.nan_to_num(np.abs(freq), nan=0.0).max(initial=0.0))
+    real = np.isfinite(freq) & (np.abs(freq) <= _ROUND_OFF_FREQUENCY * np.nanmax(np.abs(freq), initial=0.0))
     zeta = np.where(real, np.sign(zeta), zeta)
     freq = np.where(real, 0.0, freq)
     result = dict(labels=model.labels, speed_m_s=speeds, frequency_hz=freq, damping_ratio=zeta,

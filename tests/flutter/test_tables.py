@@ -174,7 +174,6 @@ def test_a_pair_without_a_root_in_the_table_does_not_stop_the_stage(tmp_path):
     assert f"SS-T1 {first:.1f}-" in rep.split("Damping computed only where the aerodynamic data cover")[1]
 
 
-
 def test_pk_coverage_lists_the_stretches_with_data_and_skips_single_unresolved_points():
     from bridge.flutter.multimode import MultimodeResult
     from bridge.flutter.stage import _pk_coverage
@@ -188,6 +187,7 @@ def test_pk_coverage_lists_the_stretches_with_data_and_skips_single_unresolved_p
                         damping_ratio=z, flutter=False, critical_speed_m_s=np.nan, frequency_hz_at_flutter=np.nan,
                         reduced_frequency=np.nan, unstable_mode="", max_speed_searched_m_s=100.0)
     assert _pk_coverage(m) == ["B 40.0-100.0 m/s", "D 10.0-40.0 m/s, 70.0-100.0 m/s"]
+
 
 # ------------------------------------------------------------------------------ columns
 def test_every_known_column_is_read_and_provides_follows_the_columns(tmp_path):
