@@ -1,0 +1,81 @@
+"""tools/openfoam_plate.py without OpenFOAM: its graded edges, its block mesh and its force conversion
+(the loads of Theodorsen's plate, 1935, NACA Report 496, put in as OpenFOAM writes them, give his
+derivatives back)."""
+
+import math
+
+import numpy as np
+import pytest
+from cfd_helpers import load_tool
+
+from bridge.aero.forced_motion import THESIS_HEAVE_RATE, THESIS_PITCH_RATE
+from bridge.flutter.aerodynamics import Theodorsen
+from bridge.flutter.derivatives import derivatives_from_frf
+
+
+def _cells(segments):
+    """Cell sizes along an edge from blockMesh's (length, cells, last/first) segments."""
+    sizes = []
+    for length, n, ratio in segments:
+        r = ratio ** (1.0 / (n - 1)) if n > 1 else 1.0
+        first = length / n if abs(r - 1.0) < 1e-12 else length * (r - 1.0) / (r ** n - 1.0)
+        sizes.extend(first * r ** np.arange(n))
+    return np.array(sizes)
+
+
+@pytest.mark.parametrize("length, first, largest, growth", [(2.5, 0.0025, 0.1, 1.05), (0.5, 0.0025, 0.01, 1.05),
+                                                            (0.3, 0.001, 0.2, 1.1), (1.0, 0.05, 0.02, 1.05)])
+def test_graded_edges_fill_their_length_and_grow_as_asked(length, first, largest, growth):
+    of = load_tool("openfoam_plate")
+    sizes = _cells(of.graded(length, first, largest, growth))
+    assert sizes.sum() == pytest.approx(length, rel=0.02)
+    assert sizes[0] == pytest.approx(min(first, length / round(length / first)), rel=0.05)
+    assert sizes.max() <= max(largest, first) * 1.05
+    assert np.all(sizes[1:] / sizes[:-1] <= growth * 1.02)
+
+
+def test_block_mesh_has_eight_blocks_round_the_plate_with_right_handed_cells():
+    of = load_tool("openfoam_plate")
+    text, cells = of.block_mesh_dict(0.005, 0.02, 1.1)
+    verts = np.array([[float(v) for v in line.strip()[1:-1].split()]
+                      for line in text.split("vertices\n(\n")[1].split("\n);")[0].splitlines()])
+    blocks = [line for line in text.splitlines() if line.strip().startswith("hex")]
+    assert len(blocks) == 8 and len(verts) == 32
+    total = 0
+    for line in blocks:
+        ids = [int(s) for s in line.split("(")[1].split(")")[0].split()]
+        nx, ny, _ = (int(s) for s in line.split(")")[1].split("(")[1].split())
+        total += nx * ny
+        p0, p1, p3 = verts[ids[0]], verts[ids[1]], verts[ids[3]]
+        assert (p1[0] - p0[0]) * (p3[1] - p0[1]) > 0           # counter-clockwise bottom face
+        assert verts[ids[4]][2] > p0[2]                          # the top face above it
+        # no block covers the plate
+        centre = verts[[ids[0], ids[2]]].mean(axis=0)
+        assert not (abs(centre[0]) < 0.5 and abs(centre[1]) < 0.01)
+    assert total == cells
+    plate = text.split("plate\n")[1].split(");")[0]
+    assert plate.count("(") - 1 == 4                             # four faces: top, bottom, both edges
+
+
+@pytest.mark.parametrize("dof", ["heave", "pitch"])
+def test_forces_as_openfoam_writes_them_give_theodorsens_derivatives(dof):
+    """Theodorsen's loads for the motion a sin(K t) written as OpenFOAM's forces on the plate: the lift
+    F_y, a steady drag, the moment about the fixed origin (counter-clockwise, so a nose-up moment is
+    negative, and in heave the mid-chord is at (0, h(t)))."""
+    of = load_tool("openfoam_plate")
+    K = 2 * math.pi / 4
+    a = (THESIS_HEAVE_RATE if dof == "heave" else THESIS_PITCH_RATE) / K
+    h = Theodorsen().frf(np.array([K]), 1.0)
+    t = np.linspace(0.0, 6 * 2 * math.pi / K, 9001)
+    e = -1j * a * np.exp(1j * K * t)       # a sin(K t) = Re(-i a e^{iKt})
+    lift_h, moment_h = (h.h_pu, h.h_mu) if dof == "heave" else (h.h_ptheta, h.h_mtheta)
+    lift = np.real(0.5 * complex(np.asarray(lift_h)[0]) * e)
+    nose_up = np.real(0.5 * complex(np.asarray(moment_h)[0]) * e)
+    drag = 0.04 + 0 * t
+    heave = a * np.sin(K * t) if dof == "heave" else 0 * t
+    mz = -nose_up - heave * drag
+    out = of.derivatives(dof, K, a, {"t": t, "fx": drag, "fy": lift, "mz": mz}, discard=2)
+    ref = derivatives_from_frf(np.array([K]), h)
+    for name in of.DERIVATIVES[dof]:
+        assert out[name]["openfoam"] == pytest.approx(float(np.asarray(getattr(ref, name))[0]), rel=1e-6), name
+        assert abs(out[name]["relative_difference"]) < 1e-6

@@ -1,0 +1,475 @@
+"""A body-fitted reference for the heaving or pitching thin plate: the same case in OpenFOAM (docs/aero.md).
+
+    python tools/openfoam_plate.py --reduced-velocity 4 [--dof heave|pitch] [--edge-cell 0.0025]
+                                   [--reynolds 1000] [--thickness 0.02] [--periods 6] [--procs 2]
+
+Why: the plate's flutter derivatives from our CFD miss Theodorsen's by 10-20 % at U/(fB) = 4 whatever the
+grid, step, domain or edges (docs/aero.md), and the question left was whether that is the viscous flow or
+the immersed boundary.  This tool answers it with a code nobody here wrote and a method that has no
+immersed boundary: OpenFOAM's pimpleFoam (laminar, second order in space and time) on a block mesh fitted
+to the plate (square edges, cells clustered at its surfaces and edges), the whole mesh moving with the plate
+as a rigid body.  Same plate, Reynolds number, domain (3 chords from mid-chord to the inflow, 20 to the
+outflow, slip sides 3 chords from the centre line), thesis amplitude and fit (whole periods after the
+transient, bridge.aero.frequency_response) as `python tools/validate_aero.py`.
+
+Heave is a rigid translation of the whole mesh (``oscillatingLinearMotion``).  Pitch rotates the plate's
+surface about its mid-chord and deforms the mesh around it (``displacementLaplacian`` with
+``angularOscillatingDisplacement`` on the plate), so that the inflow, outflow and sides stay where they are.
+
+Needs OpenFOAM (ESI v1912 was used: Debian's package ``openfoam``, ``apt-get install openfoam``); not a
+dependency of the project.  Writes the case to ``--out`` (default out/openfoam_plate/<case>), runs
+blockMesh, decomposePar and pimpleFoam on ``--procs`` cores showing progress, resumes from the last
+written time if rerun, and prints the derivatives beside Theodorsen's; the numbers go to ``result.json``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import re
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+
+from bridge.aero.forced_motion import THESIS_HEAVE_RATE, THESIS_PITCH_RATE  # noqa: E402
+from bridge.aero.frequency_response import forced_motion_response  # noqa: E402
+from bridge.flutter.aerodynamics import Theodorsen  # noqa: E402
+from bridge.flutter.derivatives import FRF, derivatives_from_frf  # noqa: E402
+
+UPSTREAM, DOWNSTREAM, HALF_HEIGHT = 3.0, 20.0, 3.0      # the standard preset's domain, chords from mid-chord
+PROVIDES = {"heave": ("h_pu", "h_mu"), "pitch": ("h_ptheta", "h_mtheta")}
+DERIVATIVES = {"heave": ("H1", "H4", "A1", "A4"), "pitch": ("H2", "H3", "A2", "A3")}
+
+HEADER = """FoamFile
+{{
+    version 2.0;
+    format ascii;
+    class {cls};
+    object {obj};
+}}
+"""
+
+
+# ---------------------------------------------------------------------------------------------- the mesh
+
+
+def graded(length: float, first: float, largest: float, growth: float) -> list[tuple[float, int, float]]:
+    """Cells along an edge of ``length``: from ``first`` growing by about ``growth`` per cell to
+    ``largest``, then uniform.  Segments (length, cells, last cell / first cell) for blockMesh."""
+    if first >= largest:
+        return [(length, max(1, round(length / first)), 1.0)]
+    n = max(2, math.ceil(math.log(largest / first) / math.log(growth)) + 1)
+    r = (largest / first) ** (1.0 / (n - 1))
+    grown = first * (r ** n - 1.0) / (r - 1.0)
+    if grown >= length:      # the edge ends before the cells reach ``largest``: grow over all of it
+        n = max(2, math.ceil(math.log(1.0 + length * (growth - 1.0) / first) / math.log(growth)))
+        lo, hi = 1.0 + 1e-9, 2.0       # the ratio r with first (r^n - 1) / (r - 1) = length
+        for _ in range(200):
+            r = 0.5 * (lo + hi)
+            (lo, hi) = (r, hi) if first * (r ** n - 1.0) / (r - 1.0) < length else (lo, r)
+        return [(length, n, r ** (n - 1))]
+    return [(grown, n, largest / first), (length - grown, max(1, math.ceil((length - grown) / largest - 1e-9)), 1.0)]
+
+
+def reverse(segments):
+    return [(seg_len, n, 1.0 / e) for seg_len, n, e in reversed(segments)]
+
+
+def grading_spec(segments) -> tuple[int, str]:
+    """blockMesh's multi-grading for ``segments`` (fractions of length and of cells, expansion)."""
+    total_len, total_n = sum(s[0] for s in segments), sum(s[1] for s in segments)
+    parts = " ".join(f"({s[0] / total_len:.12g} {s[1] / total_n:.12g} {s[2]:.12g})" for s in segments)
+    return total_n, f"({parts})"
+
+
+def block_mesh_dict(edge: float, thickness: float, growth: float) -> tuple[str, int]:
+    """The plate (chord 1, mid-chord at the origin) in 8 blocks round it; cells of ``edge`` at its surfaces
+    and edges, at most ``growth`` larger from cell to cell, 20 per chord in the near wake (to 8 chords behind
+    the plate: the wake at U/(fB) = 4 sheds 4 chords a period), 10 per chord at the far boundaries."""
+    half = 0.5 * thickness
+    wake = 0.05
+    xs = [-UPSTREAM, -0.5, 0.5, DOWNSTREAM]
+    ys = [-HALF_HEIGHT, -half, half, HALF_HEIGHT]
+    up = reverse(graded(UPSTREAM - 0.5, edge, 0.1, growth))
+    chord = graded(0.5, edge, 0.01, growth)
+    chord = chord + reverse(chord)
+    near = graded(7.5, edge, wake, growth)
+    down = near + graded(DOWNSTREAM - 8.0, wake, 0.1, growth)
+    side = graded(HALF_HEIGHT - half, edge, 0.1, growth)
+    across = [(thickness, max(2, round(thickness / edge)), 1.0)]
+    x_spec = [grading_spec(s) for s in (up, chord, down)]
+    y_spec = [grading_spec(s) for s in (reverse(side), across, side)]
+
+    def v(i, j, k):
+        return k * 16 + j * 4 + i
+
+    verts = "\n".join(f"    ({x:.12g} {y:.12g} {z:g})" for z in (0.0, 1.0) for y in ys for x in xs)
+    blocks, cells = [], 0
+    for j in range(3):
+        for i in range(3):
+            if (i, j) == (1, 1):
+                continue      # the plate
+            hexv = " ".join(str(n) for n in (v(i, j, 0), v(i + 1, j, 0), v(i + 1, j + 1, 0), v(i, j + 1, 0),
+                                             v(i, j, 1), v(i + 1, j, 1), v(i + 1, j + 1, 1), v(i, j + 1, 1)))
+            (nx, gx), (ny, gy) = x_spec[i], y_spec[j]
+            blocks.append(f"    hex ({hexv}) ({nx} {ny} 1) simpleGrading ({gx} {gy} 1)")
+            cells += nx * ny
+
+    def face(a, b):     # the side face through bottom vertices a and b
+        return f"({a} {b} {b + 16} {a + 16})"
+
+    inlet = [face(v(0, j, 0), v(0, j + 1, 0)) for j in range(3)]
+    outlet = [face(v(3, j, 0), v(3, j + 1, 0)) for j in range(3)]
+    bottom = [face(v(i, 0, 0), v(i + 1, 0, 0)) for i in range(3)]
+    top = [face(v(i, 3, 0), v(i + 1, 3, 0)) for i in range(3)]
+    plate = [face(v(1, 1, 0), v(2, 1, 0)), face(v(1, 2, 0), v(2, 2, 0)),
+             face(v(1, 1, 0), v(1, 2, 0)), face(v(2, 1, 0), v(2, 2, 0))]
+    empty = []
+    for j in range(3):
+        for i in range(3):
+            if (i, j) != (1, 1):
+                empty.append(f"({v(i, j, 0)} {v(i, j + 1, 0)} {v(i + 1, j + 1, 0)} {v(i + 1, j, 0)})")
+                empty.append(f"({v(i, j, 1)} {v(i + 1, j, 1)} {v(i + 1, j + 1, 1)} {v(i, j + 1, 1)})")
+
+    def patch(name, kind, faces):
+        body = "\n".join(f"            {f}" for f in faces)
+        return f"    {name}\n    {{\n        type {kind};\n        faces\n        (\n{body}\n        );\n    }}"
+
+    text = (HEADER.format(cls="dictionary", obj="blockMeshDict") + "convertToMeters 1;\n\nvertices\n(\n" + verts
+            + "\n);\n\nblocks\n(\n" + "\n".join(blocks) + "\n);\n\nedges ();\n\nboundary\n(\n"
+            + "\n".join([patch("inlet", "patch", inlet), patch("outlet", "patch", outlet),
+                         patch("bottom", "patch", bottom), patch("top", "patch", top),
+                         patch("plate", "wall", plate), patch("frontAndBack", "empty", empty)])
+            + "\n);\n\nmergePatchPairs ();\n")
+    return text, cells
+
+
+# ---------------------------------------------------------------------------------------------- the case
+
+
+def write_case(case: Path, dof: str, K: float, amplitude: float, reynolds: float, thickness: float,
+               edge: float, growth: float, end_time: float, write_interval: float, procs: int, max_co: float) -> int:
+    for sub in ("system", "constant", "0"):
+        (case / sub).mkdir(parents=True, exist_ok=True)
+    mesh, cells = block_mesh_dict(edge, thickness, growth)
+    (case / "system" / "blockMeshDict").write_text(mesh)
+    (case / "system" / "controlDict").write_text(HEADER.format(cls="dictionary", obj="controlDict") + f"""
+application pimpleFoam;
+startFrom latestTime;
+startTime 0;
+stopAt endTime;
+endTime {end_time:.12g};
+deltaT {0.2 * edge:.6g};
+writeControl adjustableRunTime;
+writeInterval {write_interval:.12g};
+purgeWrite 2;
+writeFormat binary;
+writePrecision 12;
+timeFormat general;
+timePrecision 12;
+runTimeModifiable no;
+adjustTimeStep yes;
+maxCo {max_co:g};
+maxDeltaT 1;
+functions
+{{
+    forces
+    {{
+        type forces;
+        libs ("libforces.so");
+        patches (plate);
+        rho rhoInf;
+        rhoInf 1;
+        CofR (0 0 0);
+        writeControl timeStep;
+        writeInterval 1;
+        log false;
+    }}
+}}
+""")
+    (case / "system" / "fvSchemes").write_text(HEADER.format(cls="dictionary", obj="fvSchemes") + """
+ddtSchemes { default backward; }
+gradSchemes { default Gauss linear; }
+divSchemes
+{
+    default none;
+    div(phi,U) Gauss linearUpwind grad(U);
+    div((nuEff*dev2(T(grad(U))))) Gauss linear;
+}
+laplacianSchemes { default Gauss linear corrected; }
+interpolationSchemes { default linear; }
+snGradSchemes { default corrected; }
+""")
+    (case / "system" / "fvSolution").write_text(HEADER.format(cls="dictionary", obj="fvSolution") + """
+solvers
+{
+    p { solver GAMG; smoother GaussSeidel; tolerance 1e-6; relTol 0.05; }
+    pFinal { $p; relTol 0; }
+    "pcorr.*" { $p; tolerance 1e-6; relTol 0; }
+    "(U|UFinal)" { solver smoothSolver; smoother symGaussSeidel; tolerance 1e-8; relTol 0; }
+    cellDisplacement { solver PCG; preconditioner DIC; tolerance 1e-10; relTol 0; }
+    cellDisplacementFinal { $cellDisplacement; }
+}
+PIMPLE
+{
+    momentumPredictor yes;
+    nOuterCorrectors 1;
+    nCorrectors 2;
+    nNonOrthogonalCorrectors 0;     // the mesh is orthogonal
+    correctPhi no;
+}
+""")
+    (case / "system" / "decomposeParDict").write_text(HEADER.format(cls="dictionary", obj="decomposeParDict") + f"""
+numberOfSubdomains {procs};
+method simple;
+coeffs {{ n ({procs} 1 1); delta 0.001; }}
+""")
+    (case / "constant" / "transportProperties").write_text(
+        HEADER.format(cls="dictionary", obj="transportProperties")
+        + f"\ntransportModel Newtonian;\nnu {1.0 / reynolds:.12g};\n")
+    (case / "constant" / "turbulenceProperties").write_text(
+        HEADER.format(cls="dictionary", obj="turbulenceProperties") + "\nsimulationType laminar;\n")
+    if dof == "heave":
+        motion = f"""
+motionSolver solidBody;
+solidBodyMotionFunction oscillatingLinearMotion;
+amplitude (0 {amplitude:.12g} 0);
+omega {K:.12g};
+"""
+    else:
+        motion = """
+motionSolver displacementLaplacian;
+diffusivity inverseDistance (plate);
+"""
+    (case / "constant" / "dynamicMeshDict").write_text(
+        HEADER.format(cls="dictionary", obj="dynamicMeshDict")
+        + "\ndynamicFvMesh dynamicMotionSolverFvMesh;\nmotionSolverLibs (\"libfvMotionSolvers.so\");\n" + motion)
+    far = "inlet|outlet|bottom|top"
+    (case / "0" / "U").write_text(HEADER.format(cls="volVectorField", obj="U") + """
+dimensions [0 1 -1 0 0 0 0];
+internalField uniform (1 0 0);
+boundaryField
+{
+    inlet { type fixedValue; value uniform (1 0 0); }
+    outlet { type inletOutlet; inletValue uniform (0 0 0); value uniform (1 0 0); }
+    "(bottom|top)" { type slip; }
+    plate { type movingWallVelocity; value uniform (0 0 0); }
+    frontAndBack { type empty; }
+}
+""")
+    (case / "0" / "p").write_text(HEADER.format(cls="volScalarField", obj="p") + """
+dimensions [0 2 -2 0 0 0 0];
+internalField uniform 0;
+boundaryField
+{
+    inlet { type zeroGradient; }
+    outlet { type fixedValue; value uniform 0; }
+    "(bottom|top)" { type zeroGradient; }
+    plate { type zeroGradient; }
+    frontAndBack { type empty; }
+}
+""")
+    if dof == "pitch":
+        # nose-up is clockwise: a negative rotation about z
+        header = HEADER.format(cls="pointVectorField", obj="pointDisplacement")
+        (case / "0" / "pointDisplacement").write_text(header + f"""
+dimensions [0 1 0 0 0 0 0];
+internalField uniform (0 0 0);
+boundaryField
+{{
+    "({far})" {{ type fixedValue; value uniform (0 0 0); }}
+    plate
+    {{
+        type angularOscillatingDisplacement;
+        axis (0 0 -1);
+        origin (0 0 0);
+        angle0 0;
+        amplitude {amplitude:.12g};
+        omega {K:.12g};
+        value uniform (0 0 0);
+    }}
+    frontAndBack {{ type empty; }}
+}}
+""")
+    return cells
+
+
+def _foam_env() -> dict:
+    env = dict(os.environ)
+    if "WM_PROJECT_DIR" not in env and Path("/usr/share/openfoam/etc/controlDict").exists():
+        env["WM_PROJECT_DIR"] = "/usr/share/openfoam"      # Debian's package, without its bashrc sourced
+    env.setdefault("OMPI_ALLOW_RUN_AS_ROOT", "1")
+    env.setdefault("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+    return env
+
+
+def run(case: Path, procs: int, end_time: float, say=print) -> float:
+    """blockMesh and decomposePar (first time only), then pimpleFoam from the latest written time, with
+    progress every ~30 s.  Returns the solver's wall time in seconds."""
+    env = _foam_env()
+
+    def step(*cmd, log):
+        with open(case / log, "w") as out:
+            rc = subprocess.run(cmd, cwd=case, stdout=out, stderr=subprocess.STDOUT, env=env).returncode
+        if rc != 0:
+            raise SystemExit(f"{' '.join(cmd)} failed (exit {rc}): see {case / log}")
+
+    if not (case / "constant" / "polyMesh" / "points").exists():
+        step("blockMesh", log="log.blockMesh")
+        step("checkMesh", log="log.checkMesh")
+    if procs > 1 and not (case / "processor0").exists():
+        step("decomposePar", "-force", log="log.decomposePar")
+    cmd = (["mpirun", "-np", str(procs), "pimpleFoam", "-parallel"] if procs > 1 else ["pimpleFoam"])
+    logs = sorted(case.glob("log.pimpleFoam.*"))
+    log = case / f"log.pimpleFoam.{len(logs)}"
+    t0 = time.time()
+    with open(log, "w") as out:
+        proc = subprocess.Popen(cmd, cwd=case, stdout=out, stderr=subprocess.STDOUT, env=env)
+        pattern = re.compile(rb"^Time = ([0-9.eE+-]+)", re.M)
+        first, last_say = None, t0
+        while proc.poll() is None:
+            time.sleep(5)
+            if time.time() - last_say < 30:
+                continue
+            last_say = time.time()
+            tail = log.read_bytes()[-20000:]
+            times = pattern.findall(tail)
+            if not times:
+                continue
+            now = float(times[-1])
+            first = now if first is None else first
+            rate = (now - first) / max(time.time() - t0, 1e-9)
+            eta = (end_time - now) / rate if rate > 0 else float("nan")
+            say(f"  t = {now:.2f} of {end_time:.2f} B/V, {time.time() - t0:.0f} s, about {eta / 60:.0f} min left",
+                flush=True)
+    if proc.returncode != 0:
+        raise SystemExit(f"pimpleFoam failed (exit {proc.returncode}): see {log}")
+    return time.time() - t0
+
+
+# ---------------------------------------------------------------------------------------------- the forces
+
+
+def _numbers(line: str) -> list[float]:
+    return [float(s) for s in line.replace("(", " ").replace(")", " ").split()]
+
+
+def read_forces(case: Path) -> dict:
+    """Time, total force (x, y) and moment z about the origin, merged over restarts (a later start wins)."""
+    root = case / "postProcessing" / "forces"
+    starts = sorted(root.iterdir(), key=lambda p: float(p.name))
+    series = {}
+    for start in starts:
+        force, moment = start / "force.dat", start / "moment.dat"
+        if not force.exists():
+            raise SystemExit(f"no force.dat in {start}: the forces function object wrote something else")
+        f = [_numbers(s) for s in force.read_text().splitlines() if s and not s.startswith("#")]
+        m = [_numbers(s) for s in moment.read_text().splitlines() if s and not s.startswith("#")]
+        t0 = float(start.name)
+        for k in [k for k in series if k >= t0]:
+            del series[k]
+        for rf, rm in zip(f, m, strict=False):
+            series[rf[0]] = (rf[1], rf[2], rm[3])
+    t = np.array(sorted(series))
+    data = np.array([series[k] for k in t])
+    return {"t": t, "fx": data[:, 0], "fy": data[:, 1], "mz": data[:, 2]}
+
+
+def derivatives(dof: str, K: float, amplitude: float, forces: dict, discard: int) -> dict:
+    """Lift up and moment nose-up about the mid-chord, the first harmonics over whole periods after
+    ``discard`` and the derivatives of ``dof`` beside Theodorsen's."""
+    t = forces["t"]
+    motion = amplitude * np.sin(K * t)
+    lift = forces["fy"]
+    if dof == "heave":   # the moment about the plate's mid-chord, which is at (0, h(t)) while the origin stays
+        moment = -(forces["mz"] + motion * forces["fx"])
+    else:
+        moment = -forces["mz"]
+    T = 2 * math.pi / K
+    n = int(math.floor(t[-1] / T + 1e-9))
+    sel = (t >= discard * T - 1e-9) & (t <= n * T + 1e-9)
+    (resp,) = forced_motion_response(t[sel], motion[sel], [K], dof=dof, speed_m_s=1.0, deck_width_m=1.0,
+                                     air_density_kg_m3=1.0, lift=lift[sel], moment=moment[sel], fundamental=K)
+    ref = Theodorsen().frf(np.array([K]), 1.0)
+    h = {name: complex(getattr(resp.frf, name)) for name in PROVIDES[dof]}
+    frf = FRF(*(np.array([h.get(name, complex(np.asarray(getattr(ref, name))[0]))])
+                for name in ("h_pu", "h_ptheta", "h_mu", "h_mtheta")))
+    cfd, theo = derivatives_from_frf(np.array([K]), frf), derivatives_from_frf(np.array([K]), ref)
+    out = {"periods_fitted": int(resp.periods), "frf": {k: [v.real, v.imag] for k, v in h.items()}}
+    for name in DERIVATIVES[dof]:
+        c, r = float(np.asarray(getattr(cfd, name))[0]), float(np.asarray(getattr(theo, name))[0])
+        out[name] = {"openfoam": c, "theodorsen": r, "relative_difference": (c - r) / abs(r)}
+    return out
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--reduced-velocity", type=float, default=4.0, help="U/(fB) (default 4)")
+    ap.add_argument("--dof", choices=("heave", "pitch"), default="heave")
+    ap.add_argument("--edge-cell", type=float, default=0.0025, help="cell at the plate, chords (default 0.0025)")
+    ap.add_argument("--growth", type=float, default=1.05, help="largest cell-to-cell growth (default 1.05)")
+    ap.add_argument("--reynolds", type=float, default=1000.0, help="V B / nu (default 1000, the standard preset)")
+    ap.add_argument("--thickness", type=float, default=0.02, help="of the chord (default 0.02)")
+    ap.add_argument("--periods", type=int, default=6, help="periods run (default 6)")
+    ap.add_argument("--discard", type=int, default=3, help="periods dropped before the fit (default 3)")
+    ap.add_argument("--amplitude-scale", type=float, default=1.0, help="times the thesis amplitude (default 1)")
+    ap.add_argument("--max-co", type=float, default=0.8, help="Courant number limit (default 0.8)")
+    ap.add_argument("--procs", type=int, default=2, help="MPI ranks (default 2)")
+    ap.add_argument("--out", type=Path, default=None, help="case folder (default out/openfoam_plate/<case>)")
+    ap.add_argument("--mesh-only", action="store_true", help="write the case and report the mesh, run nothing")
+    args = ap.parse_args(argv)
+    for name, value, lo in (("--reduced-velocity", args.reduced_velocity, 0.0), ("--edge-cell", args.edge_cell, 0.0),
+                            ("--reynolds", args.reynolds, 0.0), ("--thickness", args.thickness, 0.0),
+                            ("--amplitude-scale", args.amplitude_scale, 0.0), ("--max-co", args.max_co, 0.0)):
+        if not value > lo:
+            ap.error(f"{name}: must be > {lo:g}, got {value:g}")
+    if not 1.0 < args.growth <= 1.3:
+        ap.error(f"--growth: must be in (1, 1.3], got {args.growth:g}")
+    if not 0 <= args.discard < args.periods:
+        ap.error(f"--discard: must be in [0, --periods), got {args.discard}")
+    if not args.mesh_only:
+        missing = [c for c in ("blockMesh", "pimpleFoam") + (("mpirun", "decomposePar") if args.procs > 1 else ())
+                   if shutil.which(c) is None]
+        if missing:
+            print(f"error: {', '.join(missing)} not found: install OpenFOAM (apt-get install openfoam)",
+                  file=sys.stderr)
+            return 2
+    K = 2 * math.pi / args.reduced_velocity
+    rate = THESIS_HEAVE_RATE if args.dof == "heave" else THESIS_PITCH_RATE
+    amplitude = args.amplitude_scale * rate / K
+    name = (f"{args.dof}_U{args.reduced_velocity:g}_Re{args.reynolds:g}_t{args.thickness:g}_e{args.edge_cell:g}"
+            f"_g{args.growth:g}_a{args.amplitude_scale:g}")
+    case = args.out or Path("out") / "openfoam_plate" / name
+    T = 2 * math.pi / K
+    end_time = args.periods * T
+    cells = write_case(case, args.dof, K, amplitude, args.reynolds, args.thickness, args.edge_cell, args.growth,
+                       end_time, T, args.procs, args.max_co)
+    print(f"{name}: {cells} cells, {args.periods} periods of {T:.3f} B/V, amplitude "
+          f"{amplitude:.5g} {'chords' if args.dof == 'heave' else 'rad'}; case in {case}", flush=True)
+    if args.mesh_only:
+        return 0
+    wall = run(case, args.procs, end_time)
+    forces = read_forces(case)
+    result = {"case": name, "dof": args.dof, "reduced_velocity": args.reduced_velocity, "K": K,
+              "reynolds": args.reynolds, "thickness": args.thickness, "edge_cell": args.edge_cell,
+              "growth": args.growth, "cells": cells, "amplitude": amplitude, "steps": int(forces["t"].size),
+              "wall_s": wall, **derivatives(args.dof, K, amplitude, forces, args.discard)}
+    (case / "result.json").write_text(json.dumps(result, indent=1))
+    print(f"{cells} cells, {forces['t'].size} steps, {wall:.0f} s; {result['periods_fitted']} periods fitted")
+    for n in DERIVATIVES[args.dof]:
+        r = result[n]
+        print(f"  {n}*: OpenFOAM {r['openfoam']:+.4f}, Theodorsen {r['theodorsen']:+.4f} "
+              f"({100 * r['relative_difference']:+.1f} %)")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
