@@ -344,12 +344,11 @@ def run(case: Path, procs: int, end_time: float, say=print) -> float:
             times = pattern.findall(tail)
             if not times:
                 continue
-            now = float(times[-1])
-            first = now if first is None else first
-            rate = (now - first) / max(time.time() - t0, 1e-9)
-            eta = (end_time - now) / rate if rate > 0 else float("nan")
-            say(f"  t = {now:.2f} of {end_time:.2f} B/V, {time.time() - t0:.0f} s, about {eta / 60:.0f} min left",
-                flush=True)
+            now, wall = float(times[-1]), time.time()
+            first = (now, wall) if first is None else first     # the rate from the first report on
+            rate = (now - first[0]) / max(wall - first[1], 1e-9)
+            left = f"about {(end_time - now) / rate / 60:.0f} min left" if rate > 0 else "rate not known yet"
+            say(f"  t = {now:.2f} of {end_time:.2f} B/V, {wall - t0:.0f} s, {left}", flush=True)
     if proc.returncode != 0:
         raise SystemExit(f"pimpleFoam failed (exit {proc.returncode}): see {log}")
     return time.time() - t0
