@@ -2,6 +2,7 @@
 
     python tools/validate_aero.py --quality standard --reduced-velocities 4 8 12 [--thickness 0.02]
                                   [--grid overset] [--turbulence sst --reynolds 1e6] [--threads N]
+                                  [--cells-per-chord N --dy-over-dx R --background-coarsening C]
 
 Runs one heave and one pitch case per reduced velocity with the aero stage's runner (bridge.aero:
 thesis velocity amplitudes, transient periods dropped, harmonic fit over whole periods) and prints the
@@ -40,30 +41,44 @@ from bridge.aero.frequency_response import forced_motion_response  # noqa: E402
 from bridge.aero.options import AeroOptions  # noqa: E402
 from bridge.aero.stage import _unit_polygon  # noqa: E402
 from bridge.cfd.sections import FlatPlate  # noqa: E402
+from bridge.errors import InputError  # noqa: E402
 from bridge.flutter.aerodynamics import Theodorsen  # noqa: E402
 from bridge.flutter.derivatives import FRF, derivatives_from_frf  # noqa: E402
 
 NAMES = ("H1", "H2", "H3", "H4", "A1", "A2", "A3", "A4")
 
 
-def plate_quality(quality: str, grid: str, turbulence: str = "laminar", reynolds: float | None = None):
-    """The preset on ``grid``; with ``turbulence = "sst"`` the k-omega SST model at ``reynolds``."""
+# the preset's grid fields a run may replace (a grid study beyond the presets, docs/aero.md)
+GRID_FIELDS = ("cells_per_chord", "dy_over_dx", "background_coarsening")
+
+
+def plate_quality(quality: str, grid: str, turbulence: str = "laminar", reynolds: float | None = None,
+                  grid_overrides: dict | None = None):
+    """The preset on ``grid``; with ``turbulence = "sst"`` the k-omega SST model at ``reynolds``;
+    ``grid_overrides`` replaces fields of GRID_FIELDS (checked by Quality: InputError names the field)."""
     q = preset(quality, grid)
     if turbulence != "laminar":
         q = replace(q, turbulence=turbulence, reynolds=float(reynolds))
     elif reynolds is not None:
         q = replace(q, reynolds=float(reynolds))
-    return q
+    overrides = {k: v for k, v in (grid_overrides or {}).items() if v is not None}
+    unknown = sorted(set(overrides) - set(GRID_FIELDS))
+    if unknown:
+        raise ValueError(f"grid_overrides: {unknown} not among {GRID_FIELDS}")
+    return replace(q, **overrides)
 
 
 def plate_derivatives(reduced_velocity: float, quality: str, thickness: float, say=print,
                       runs: Path | None = None, grid: str = "single", turbulence: str = "laminar",
-                      reynolds: float | None = None, threads: int | None = None) -> dict:
+                      reynolds: float | None = None, threads: int | None = None,
+                      grid_overrides: dict | None = None, dofs=("heave", "pitch")) -> dict:
+    """One heave and one pitch run (``dofs``: one of them alone gives only its four derivatives, the
+    others None) at ``reduced_velocity``; a row of the derivatives beside Theodorsen's."""
     poly = _unit_polygon(FlatPlate(1.0, thickness))
-    q = plate_quality(quality, grid, turbulence, reynolds)
+    q = plate_quality(quality, grid, turbulence, reynolds, grid_overrides)
     K = 2 * np.pi / reduced_velocity
     h, wall = {}, 0.0
-    for dof in ("heave", "pitch"):
+    for dof in dofs:
         case = ForcedCase.thesis(dof, K)
         rec = run_case(poly, case, q, checkpoint_path(runs, poly, case, q), progress=say,
                        label=f"U/(fB) = {reduced_velocity:g} {dof}", threads=threads)
@@ -75,22 +90,26 @@ def plate_derivatives(reduced_velocity: float, quality: str, thickness: float, s
         h.update({n: complex(getattr(resp.frf, n)) for n in resp.provides})
         periods = resp.periods
         cells = (rec.meta["nx"], rec.meta["ny"])
-    frf = FRF(h_pu=h["h_pu"], h_ptheta=h["h_ptheta"], h_mu=h["h_mu"], h_mtheta=h["h_mtheta"])
-    cfd = derivatives_from_frf(np.array([K]), FRF(*(np.array([v]) for v in frf[:4])))
+    missing = complex(np.nan, np.nan)   # a dof not run: its derivatives come out NaN, reported as None
+    frf = FRF(*(np.array([h.get(n, missing)]) for n in ("h_pu", "h_ptheta", "h_mu", "h_mtheta")))
+    cfd = derivatives_from_frf(np.array([K]), frf)
     ref = derivatives_from_frf(np.array([K]), Theodorsen().frf(np.array([K]), 1.0))
     row = {"reduced_velocity": reduced_velocity, "K": K, "quality": quality, "grid": grid, "thickness": thickness,
            "turbulence": q.turbulence, "reynolds": q.reynolds,
+           **{k: getattr(q, k) for k in GRID_FIELDS},
            "cells": cells, "grids": rec.meta["grids"], "wall_s": wall, "periods_fitted": periods,
            "frf": {k: [v.real, v.imag] for k, v in h.items()}}
     for n in NAMES:
         c, r = float(np.asarray(getattr(cfd, n))[0]), float(np.asarray(getattr(ref, n))[0])
-        row[n] = {"cfd": c, "theodorsen": r, "relative_difference": (c - r) / abs(r)}
+        row[n] = ({"cfd": c, "theodorsen": r, "relative_difference": (c - r) / abs(r)} if np.isfinite(c)
+                  else {"cfd": None, "theodorsen": r, "relative_difference": None})
     return row
 
 
 def multi_frequency_check(reduced_velocities, quality: str, thickness: float, singles: list[dict], say=print,
                           runs: Path | None = None, grid: str = "single", turbulence: str = "laminar",
-                          reynolds: float | None = None, threads: int | None = None) -> list:
+                          reynolds: float | None = None, threads: int | None = None,
+                          grid_overrides: dict | None = None) -> list:
     """One heave and one pitch run at all the reduced velocities at once (ForcedCase.multi_frequency, each
     sine at the single run's amplitude) against the single runs ``singles``: rows of
     (U/(fB), name, multi, single, |multi - single| / |single|)."""
@@ -129,31 +148,47 @@ def main(argv=None) -> int:
     ap.add_argument("--reynolds", type=float, default=None,
                     help="Reynolds number on the chord (default: the preset's; needed with --turbulence sst)")
     ap.add_argument("--threads", type=int, default=None, help="CPU threads of each case (default: run_case's)")
+    ap.add_argument("--cells-per-chord", type=int, default=None,
+                    help="replace the preset's cells per chord (x spacing; a grid study beyond the presets)")
+    ap.add_argument("--dy-over-dx", type=float, default=None, help="replace the preset's dy / dx at the section")
+    ap.add_argument("--background-coarsening", type=int, default=None,
+                    help="replace the preset's background cell / body cell (overset grid)")
+    ap.add_argument("--dofs", nargs="+", choices=["heave", "pitch"], default=["heave", "pitch"],
+                    help="the runs per reduced velocity (default both; heave alone gives H1*, H4*, A1*, A4*)")
     ap.add_argument("--out", type=Path, default=Path("out/validate_aero.json"))
     args = ap.parse_args(argv)
+    if args.multi and len(set(args.dofs)) < 2:
+        ap.error("--multi needs both --dofs (heave and pitch)")
     if args.turbulence == "sst" and args.reynolds is None:
         ap.error("--turbulence sst needs --reynolds (e.g. 1e6)")
     if args.reynolds is not None and not 1.0 <= args.reynolds <= 1e10:
         ap.error(f"--reynolds: {args.reynolds} not allowed; allowed: 1 .. 1e10")
     if args.threads is not None and not 1 <= args.threads <= 64:
         ap.error(f"--threads: {args.threads} not allowed; allowed: 1 .. 64")
-    flow = {"turbulence": args.turbulence, "reynolds": args.reynolds, "threads": args.threads}
+    overrides = {k: getattr(args, k) for k in GRID_FIELDS}
+    try:   # the preset checks the replaced fields: a bad value stops here, before any run
+        plate_quality(args.quality, args.grid, args.turbulence, args.reynolds, overrides)
+    except InputError as e:
+        ap.error(str(e))
+    flow = {"turbulence": args.turbulence, "reynolds": args.reynolds, "threads": args.threads,
+            "grid_overrides": overrides}
     t0 = time.perf_counter()
     if args.multi:   # checked before the single runs: the multi run needs U_max / m
         AeroOptions(excitation="multi", reduced_velocities=tuple(args.reduced_velocities))
     runs = args.out.parent / "validate_aero_runs"
     runs.mkdir(parents=True, exist_ok=True)
     say = lambda m: print(m, file=sys.stderr, flush=True)  # noqa: E731
-    rows = [plate_derivatives(uv, args.quality, args.thickness, say=say, runs=runs, grid=args.grid, **flow)
-            for uv in args.reduced_velocities]
+    dofs = tuple(d for d in ("heave", "pitch") if d in args.dofs)
+    rows = [plate_derivatives(uv, args.quality, args.thickness, say=say, runs=runs, grid=args.grid, dofs=dofs,
+                              **flow) for uv in args.reduced_velocities]
     print(f"thin plate t/B = {args.thickness:g}, preset {args.quality!r}, {args.grid} grid, "
           f"{rows[0]['turbulence']} at Re {rows[0]['reynolds']:.3g}, "
           f"{time.perf_counter() - t0:.0f} s ({rows[0]['grids']})")
     print("| U/(fB) | " + " | ".join(f"{n}* CFD / Theodorsen (diff)" for n in NAMES) + " |")
     print("|---|" + "---|" * len(NAMES))
     for r in rows:
-        cells = [f"{r[n]['cfd']:.3f} / {r[n]['theodorsen']:.3f} ({100 * r[n]['relative_difference']:+.0f} %)"
-                 for n in NAMES]
+        cells = [f"{r[n]['cfd']:.3f} / {r[n]['theodorsen']:.3f} ({100 * r[n]['relative_difference']:+.1f} %)"
+                 if r[n]["cfd"] is not None else f"- / {r[n]['theodorsen']:.3f}" for n in NAMES]
         print(f"| {r['reduced_velocity']:g} | " + " | ".join(cells) + " |")
     if args.multi:
         rv = AeroOptions(excitation="multi", reduced_velocities=tuple(args.reduced_velocities)).reduced_velocities

@@ -1,0 +1,49 @@
+"""tools/validate_aero.py's grid overrides (a grid study beyond the presets): they replace only the
+fields asked for, and a value outside the preset's range stops the tool before any run."""
+
+import pytest
+from cfd_helpers import load_tool
+
+from bridge.aero.forced_motion import preset
+from bridge.errors import InputError
+
+
+def test_grid_overrides_replace_only_the_fields_given():
+    va = load_tool("validate_aero")
+    q = va.plate_quality("standard", "overset", reynolds=1e4,
+                         grid_overrides={"cells_per_chord": 200, "dy_over_dx": 0.5, "background_coarsening": 4})
+    base = preset("standard", "overset")
+    assert (q.cells_per_chord, q.dy_over_dx, q.background_coarsening, q.reynolds) == (200, 0.5, 4, 1e4)
+    assert (q.upstream, q.downstream, q.periods, q.cfl) == (base.upstream, base.downstream, base.periods, base.cfl)
+    assert va.plate_quality("standard", "overset", grid_overrides={"cells_per_chord": None}) == base
+    with pytest.raises(ValueError, match="not among"):
+        va.plate_quality("standard", "overset", grid_overrides={"upstream": 8.0})
+    with pytest.raises(InputError, match="aero.dy_over_dx"):
+        va.plate_quality("standard", "overset", grid_overrides={"dy_over_dx": 2.0})
+
+
+def test_a_bad_override_exits_2_naming_the_field_and_writes_nothing(tmp_path, capsys):
+    va = load_tool("validate_aero")
+    out = tmp_path / "v.json"
+    with pytest.raises(SystemExit) as e:
+        va.main(["--cells-per-chord", "4", "--out", str(out)])
+    assert e.value.code == 2
+    err = capsys.readouterr().err
+    assert "aero.cells_per_chord" in err and "4" in err
+    assert not out.exists() and not (tmp_path / "validate_aero_runs").exists()
+
+
+def test_heave_alone_gives_its_four_derivatives_and_none_for_the_pitch_ones(tmp_path):
+    import json
+    import math
+
+    va = load_tool("validate_aero")
+    out = tmp_path / "v.json"
+    assert va.main(["--quality", "tiny", "--reduced-velocities", "4", "--thickness", "0.1", "--dofs", "heave",
+                    "--out", str(out)]) == 0
+    (row,) = json.loads(out.read_text())
+    for n in ("H1", "H4", "A1", "A4"):
+        assert math.isfinite(row[n]["cfd"]) and row[n]["cfd"] != 0.0
+    for n in ("H2", "H3", "A2", "A3"):
+        assert row[n]["cfd"] is None and row[n]["relative_difference"] is None
+    assert set(row["frf"]) == {"h_pu", "h_mu"}
