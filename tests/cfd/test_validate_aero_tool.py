@@ -47,3 +47,20 @@ def test_heave_alone_gives_its_four_derivatives_and_none_for_the_pitch_ones(tmp_
     for n in ("H2", "H3", "A2", "A3"):
         assert row[n]["cfd"] is None and row[n]["relative_difference"] is None
     assert set(row["frf"]) == {"h_pu", "h_mu"}
+
+
+def test_an_under_resolved_laminar_plate_is_flagged_and_the_validated_grids_are_not():
+    """The warnings follow the runs of docs/aero.md: the standard grid at Re 1000 resolves the plate (no
+    warning); at Re 1e5 its boundary layer spans 2.5 cells; at Re 1e4 the trailing edge sheds and 40 cells per
+    chord do not follow it, 200 do; SST stands in a wall function for the boundary layer (no warning)."""
+    va = load_tool("validate_aero")
+    assert va.resolution_warnings(va.plate_quality("standard", "overset"), 0.02) == []
+    (bl, edge) = va.resolution_warnings(va.plate_quality("standard", "overset", reynolds=1e5), 0.02)
+    assert "boundary layer" in bl and "2.5 cells" in bl
+    assert "sheds" in edge and "200 cells per chord" in edge
+    (edge,) = va.resolution_warnings(va.plate_quality("standard", "overset", reynolds=1e4), 0.02)
+    assert "sheds" in edge
+    fine = va.plate_quality("standard", "overset", reynolds=1e4,
+                            grid_overrides={"cells_per_chord": 200, "dy_over_dx": 0.5})
+    assert va.resolution_warnings(fine, 0.02) == []
+    assert va.resolution_warnings(va.plate_quality("standard", "overset", "sst", 1e6), 0.02) == []
