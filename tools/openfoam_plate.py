@@ -2,6 +2,7 @@
 
     python tools/openfoam_plate.py --reduced-velocity 4 [--dof heave|pitch] [--edge-cell 0.0025]
                                    [--reynolds 1000] [--thickness 0.02] [--periods 6] [--procs 2]
+                                   [--turbulence sst --reynolds 1e6 --edge-cell 0.005]
 
 Why: the plate's flutter derivatives from our CFD miss Theodorsen's by 10-20 % at U/(fB) = 4 whatever the
 grid, step, domain or edges (docs/aero.md), and the question left was whether that is the viscous flow or
@@ -11,6 +12,10 @@ to the plate (square edges, cells clustered at its surfaces and edges), the whol
 as a rigid body.  Same plate, Reynolds number, domain (3 chords from mid-chord to the inflow, 20 to the
 outflow, slip sides 3 chords from the centre line), thesis amplitude and fit (whole periods after the
 transient, bridge.aero.frequency_response) as `python tools/validate_aero.py`.
+
+With ``--turbulence sst`` the same case runs OpenFOAM's kOmegaSST (the 2003 variant, as bridge.cfd.turbulence)
+with our freestream k and omega and Spalding's wall function for nut on the plate: a body-fitted reference for
+the SST runs of `python tools/validate_aero.py --turbulence sst` (docs/aero.md).
 
 Heave is a rigid translation of the whole mesh (``oscillatingLinearMotion``).  Pitch rotates the plate's
 surface about its mid-chord and deforms the mesh around it (``displacementLaplacian`` with
@@ -156,7 +161,8 @@ def block_mesh_dict(edge: float, thickness: float, growth: float) -> tuple[str, 
 
 
 def write_case(case: Path, dof: str, K: float, amplitude: float, reynolds: float, thickness: float,
-               edge: float, growth: float, end_time: float, write_interval: float, procs: int, max_co: float) -> int:
+               edge: float, growth: float, end_time: float, write_interval: float, procs: int, max_co: float,
+               turbulence: str = "laminar") -> int:
     for sub in ("system", "constant", "0"):
         (case / sub).mkdir(parents=True, exist_ok=True)
     mesh, cells = block_mesh_dict(edge, thickness, growth)
@@ -203,10 +209,13 @@ divSchemes
     default none;
     div(phi,U) Gauss linearUpwind grad(U);
     div((nuEff*dev2(T(grad(U))))) Gauss linear;
+    div(phi,k) Gauss linearUpwind grad(k);
+    div(phi,omega) Gauss linearUpwind grad(omega);
 }
 laplacianSchemes { default Gauss linear corrected; }
 interpolationSchemes { default linear; }
 snGradSchemes { default corrected; }
+wallDist { method meshWave; }
 """)
     (case / "system" / "fvSolution").write_text(HEADER.format(cls="dictionary", obj="fvSolution") + """
 solvers
@@ -214,7 +223,7 @@ solvers
     p { solver GAMG; smoother GaussSeidel; tolerance 1e-6; relTol 0.05; }
     pFinal { $p; relTol 0; }
     "pcorr.*" { $p; tolerance 1e-6; relTol 0; }
-    "(U|UFinal)" { solver smoothSolver; smoother symGaussSeidel; tolerance 1e-8; relTol 0; }
+    "(U|k|omega)(|Final)" { solver smoothSolver; smoother symGaussSeidel; tolerance 1e-8; relTol 0; }
     cellDisplacement { solver PCG; preconditioner DIC; tolerance 1e-10; relTol 0; }
     cellDisplacementFinal { $cellDisplacement; }
 }
@@ -236,7 +245,11 @@ coeffs {{ n ({procs} 1 1); delta 0.001; }}
         HEADER.format(cls="dictionary", obj="transportProperties")
         + f"\ntransportModel Newtonian;\nnu {1.0 / reynolds:.12g};\n")
     (case / "constant" / "turbulenceProperties").write_text(
-        HEADER.format(cls="dictionary", obj="turbulenceProperties") + "\nsimulationType laminar;\n")
+        HEADER.format(cls="dictionary", obj="turbulenceProperties")
+        + ("\nsimulationType laminar;\n" if turbulence == "laminar" else
+           "\nsimulationType RAS;\nRAS\n{\n    RASModel kOmegaSST;\n    turbulence on;\n    printCoeffs on;\n}\n"))
+    if turbulence == "sst":
+        _write_turbulence_fields(case, reynolds)
     if dof == "heave":
         motion = f"""
 motionSolver solidBody;
@@ -300,6 +313,36 @@ boundaryField
 }}
 """)
     return cells
+
+
+def _write_turbulence_fields(case: Path, reynolds: float) -> None:
+    """k, omega and nut for OpenFOAM's kOmegaSST (Menter, Kuntz and Langtry 2003, as bridge.cfd.turbulence):
+    the freestream values of our runs (bridge.cfd.turbulence.freestream_turbulence: intensity 0.1 %, eddy
+    viscosity a hundredth of nu), and on the plate Spalding's wall function for nut, as ours, with OpenFOAM's
+    standard k and omega wall functions."""
+    from bridge.cfd.turbulence import freestream_turbulence
+
+    k_inf, omega_inf = freestream_turbulence(1.0, 1.0 / reynolds)
+    fields = {"k": ("[0 2 -2 0 0 0 0]", k_inf, "kqRWallFunction"),
+              "omega": ("[0 0 -1 0 0 0 0]", omega_inf, "omegaWallFunction"),
+              "nut": ("[0 2 -1 0 0 0 0]", 0.0, "nutUSpaldingWallFunction")}
+    for name, (dims, value, wall) in fields.items():
+        far = ("inlet { type calculated; value uniform 0; }\n    outlet { type calculated; value uniform 0; }"
+               if name == "nut" else
+               f"inlet {{ type fixedValue; value uniform {value:.12g}; }}\n"
+               f"    outlet {{ type inletOutlet; inletValue uniform {value:.12g}; value uniform {value:.12g}; }}")
+        sides = "calculated; value uniform 0" if name == "nut" else "zeroGradient"
+        (case / "0" / name).write_text(HEADER.format(cls="volScalarField", obj=name) + f"""
+dimensions {dims};
+internalField uniform {value:.12g};
+boundaryField
+{{
+    {far}
+    "(bottom|top)" {{ type {sides}; }}
+    plate {{ type {wall}; value uniform {value:.12g}; }}
+    frontAndBack {{ type empty; }}
+}}
+""")
 
 
 def _foam_env() -> dict:
@@ -417,6 +460,9 @@ def main(argv=None) -> int:
     ap.add_argument("--growth", type=float, default=1.05, help="largest cell-to-cell growth (default 1.05)")
     ap.add_argument("--reynolds", type=float, default=1000.0, help="V B / nu (default 1000, the standard preset)")
     ap.add_argument("--thickness", type=float, default=0.02, help="of the chord (default 0.02)")
+    ap.add_argument("--turbulence", choices=("laminar", "sst"), default="laminar",
+                    help="laminar (default) or k-omega SST with Spalding's wall function on the plate: the "
+                         "edge cell should then put the first cell's centre at y+ 30-100 (about 0.003 at Re 1e6)")
     ap.add_argument("--periods", type=int, default=6, help="periods run (default 6)")
     ap.add_argument("--discard", type=int, default=3, help="periods dropped before the fit (default 3)")
     ap.add_argument("--amplitude-scale", type=float, default=1.0, help="times the thesis amplitude (default 1)")
@@ -445,12 +491,12 @@ def main(argv=None) -> int:
     rate = THESIS_HEAVE_RATE if args.dof == "heave" else THESIS_PITCH_RATE
     amplitude = args.amplitude_scale * rate / K
     name = (f"{args.dof}_U{args.reduced_velocity:g}_Re{args.reynolds:g}_t{args.thickness:g}_e{args.edge_cell:g}"
-            f"_g{args.growth:g}_a{args.amplitude_scale:g}")
+            f"_g{args.growth:g}_a{args.amplitude_scale:g}" + ("_sst" if args.turbulence == "sst" else ""))
     case = args.out or Path("out") / "openfoam_plate" / name
     T = 2 * math.pi / K
     end_time = args.periods * T
     cells = write_case(case, args.dof, K, amplitude, args.reynolds, args.thickness, args.edge_cell, args.growth,
-                       end_time, T, args.procs, args.max_co)
+                       end_time, T, args.procs, args.max_co, args.turbulence)
     print(f"{name}: {cells} cells, {args.periods} periods of {T:.3f} B/V, amplitude "
           f"{amplitude:.5g} {'chords' if args.dof == 'heave' else 'rad'}; case in {case}", flush=True)
     if args.mesh_only:
@@ -458,7 +504,8 @@ def main(argv=None) -> int:
     wall = run(case, args.procs, end_time)
     forces = read_forces(case)
     result = {"case": name, "dof": args.dof, "reduced_velocity": args.reduced_velocity, "K": K,
-              "reynolds": args.reynolds, "thickness": args.thickness, "edge_cell": args.edge_cell,
+              "reynolds": args.reynolds, "turbulence": args.turbulence, "thickness": args.thickness,
+              "edge_cell": args.edge_cell,
               "growth": args.growth, "cells": cells, "amplitude": amplitude, "steps": int(forces["t"].size),
               "wall_s": wall, **derivatives(args.dof, K, amplitude, forces, args.discard)}
     (case / "result.json").write_text(json.dumps(result, indent=1))

@@ -79,3 +79,27 @@ def test_forces_as_openfoam_writes_them_give_theodorsens_derivatives(dof):
     for name in of.DERIVATIVES[dof]:
         assert out[name]["openfoam"] == pytest.approx(float(np.asarray(getattr(ref, name))[0]), rel=1e-6), name
         assert abs(out[name]["relative_difference"]) < 1e-6
+
+
+def test_the_sst_case_has_our_freestream_turbulence_and_spaldings_wall_function(tmp_path):
+    """--turbulence sst: OpenFOAM's kOmegaSST with the freestream k, omega of our runs
+    (bridge.cfd.turbulence.freestream_turbulence) and Spalding's law for nut on the plate; a laminar case
+    writes no turbulence fields."""
+    from bridge.cfd.turbulence import freestream_turbulence
+
+    of = load_tool("openfoam_plate")
+    args = dict(dof="heave", K=0.785, amplitude=0.01, thickness=0.02, edge=0.01, growth=1.05, end_time=8.0,
+                write_interval=8.0, procs=2, max_co=1.0)
+    of.write_case(tmp_path / "sst", reynolds=1e6, turbulence="sst", **args)
+    props = (tmp_path / "sst" / "constant" / "turbulenceProperties").read_text()
+    assert "simulationType RAS;" in props and "RASModel kOmegaSST;" in props
+    k_inf, omega_inf = freestream_turbulence(1.0, 1e-6)
+    for name, value, wall in (("k", k_inf, "kqRWallFunction"), ("omega", omega_inf, "omegaWallFunction"),
+                              ("nut", 0.0, "nutUSpaldingWallFunction")):
+        text = (tmp_path / "sst" / "0" / name).read_text()
+        assert f"internalField uniform {value:.12g};" in text, name
+        assert f"plate {{ type {wall};" in text, name
+    assert "div(phi,omega)" in (tmp_path / "sst" / "system" / "fvSchemes").read_text()
+    of.write_case(tmp_path / "lam", reynolds=1000.0, **args)
+    assert "simulationType laminar;" in (tmp_path / "lam" / "constant" / "turbulenceProperties").read_text()
+    assert not any((tmp_path / "lam" / "0" / n).exists() for n in ("k", "omega", "nut"))
