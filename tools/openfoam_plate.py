@@ -405,21 +405,33 @@ def _numbers(line: str) -> list[float]:
 
 
 def read_forces(case: Path) -> dict:
-    """Time, total force (x, y) and moment z about the origin, merged over restarts (a later start wins)."""
+    """Time, total force (x, y) and moment z about the origin, merged over restarts (a later start wins).
+    A restart from a time that already has a folder writes ``force_0.dat``, ``force_1.dat``, ... beside the
+    first ``force.dat`` (OpenFOAM keeps the old file): those are read in that order, each newer file from its
+    first time on replacing what the older ones held."""
     root = case / "postProcessing" / "forces"
     starts = sorted(root.iterdir(), key=lambda p: float(p.name))
     series = {}
+
+    def order(path: Path) -> int:      # force.dat first, then force_0.dat, force_1.dat, ...
+        tail = path.stem.partition("_")[2]
+        return int(tail) + 1 if tail.isdigit() else 0
+
     for start in starts:
-        force, moment = start / "force.dat", start / "moment.dat"
-        if not force.exists():
+        forces = sorted(start.glob("force*.dat"), key=order)
+        if not forces:
             raise SystemExit(f"no force.dat in {start}: the forces function object wrote something else")
-        f = [_numbers(s) for s in force.read_text().splitlines() if s and not s.startswith("#")]
-        m = [_numbers(s) for s in moment.read_text().splitlines() if s and not s.startswith("#")]
-        t0 = float(start.name)
-        for k in [k for k in series if k >= t0]:
-            del series[k]
-        for rf, rm in zip(f, m, strict=False):
-            series[rf[0]] = (rf[1], rf[2], rm[3])
+        for force in forces:
+            moment = start / force.name.replace("force", "moment", 1)
+            f = [_numbers(s) for s in force.read_text().splitlines() if s and not s.startswith("#")]
+            m = [_numbers(s) for s in moment.read_text().splitlines() if s and not s.startswith("#")]
+            if not f:
+                continue
+            t0 = min(float(start.name), f[0][0])
+            for k in [k for k in series if k >= t0]:
+                del series[k]
+            for rf, rm in zip(f, m, strict=False):
+                series[rf[0]] = (rf[1], rf[2], rm[3])
     t = np.array(sorted(series))
     data = np.array([series[k] for k in t])
     return {"t": t, "fx": data[:, 0], "fy": data[:, 1], "mz": data[:, 2]}

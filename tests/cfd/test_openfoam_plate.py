@@ -103,3 +103,23 @@ def test_the_sst_case_has_our_freestream_turbulence_and_spaldings_wall_function(
     of.write_case(tmp_path / "lam", reynolds=1000.0, **args)
     assert "simulationType laminar;" in (tmp_path / "lam" / "constant" / "turbulenceProperties").read_text()
     assert not any((tmp_path / "lam" / "0" / n).exists() for n in ("k", "omega", "nut"))
+
+
+def test_a_restart_from_the_same_time_reads_the_newer_force_file(tmp_path):
+    """A case rerun from t = 0 after a killed start: OpenFOAM keeps the old force.dat and writes force_0.dat
+    beside it; the newer file's series replaces the older one (a killed run's forces are not fitted)."""
+    of = load_tool("openfoam_plate")
+    folder = tmp_path / "postProcessing" / "forces" / "0"
+    folder.mkdir(parents=True)
+
+    def write(suffix, times, lift):
+        rows = "".join(f"{t:g} ({2 * lift:g} {lift:g} 0) (0 0 0) (0 0 0)\n" for t in times)
+        (folder / f"force{suffix}.dat").write_text("# Time total pressure viscous\n" + rows)
+        mrows = "".join(f"{t:g} (0 0 {3 * lift:g}) (0 0 0) (0 0 0)\n" for t in times)
+        (folder / f"moment{suffix}.dat").write_text("# Time total pressure viscous\n" + mrows)
+
+    write("", [0.1, 0.2, 0.3], 1.0)            # the killed start
+    write("_0", [0.1, 0.2, 0.3, 0.4], 2.0)     # the rerun
+    f = of.read_forces(tmp_path)
+    assert list(f["t"]) == [0.1, 0.2, 0.3, 0.4]
+    assert list(f["fy"]) == [2.0] * 4 and list(f["fx"]) == [4.0] * 4 and list(f["mz"]) == [6.0] * 4
