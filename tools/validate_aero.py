@@ -82,9 +82,10 @@ def resolution_warnings(q, thickness: float) -> list[str]:
     out = []
     dx = 1.0 / q.cells_per_chord
     delta = 4.91 / math.sqrt(q.reynolds)
-    if delta / (q.dy_over_dx * dx) < 4.0:
+    across = delta / (q.dy_over_dx * dx)      # cells across the boundary layer at the trailing edge
+    if across < 4.0:
         out.append(f"the boundary layer (Blasius: {delta:.3g} B at the trailing edge, Re {q.reynolds:g}) spans "
-                   f"{delta / (q.dy_over_dx * dx):.1f} cells, fewer than 4: the forces are not resolved; refine "
+                   f"{across:.1f} cells, fewer than 4: the forces are not resolved; refine "
                    "(--cells-per-chord, --dy-over-dx) or lower --reynolds")
     if q.reynolds * thickness >= 100.0 and thickness / dx < 4.0:
         out.append(f"at Re t/B = {q.reynolds * thickness:g} the square trailing edge sheds, which takes cells of a "
