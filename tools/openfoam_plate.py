@@ -3,6 +3,7 @@
     python tools/openfoam_plate.py --reduced-velocity 4 [--dof heave|pitch] [--edge-cell 0.0025]
                                    [--reynolds 1000] [--thickness 0.02] [--periods 6] [--procs 2]
                                    [--turbulence sst --reynolds 1e6 --edge-cell 0.005]
+    python tools/openfoam_plate.py --dof static --angle 2 [--duration 20] [--turbulence sst --reynolds 1e6]
 
 Why: the plate's flutter derivatives from our CFD miss Theodorsen's by 10-20 % at U/(fB) = 4 whatever the
 grid, step, domain or edges (docs/aero.md), and the question left was whether that is the viscous flow or
@@ -20,6 +21,9 @@ the SST runs of `python tools/validate_aero.py --turbulence sst` (docs/aero.md).
 Heave is a rigid translation of the whole mesh (``oscillatingLinearMotion``).  Pitch rotates the plate's
 surface about its mid-chord and deforms the mesh around it (``displacementLaplacian`` with
 ``angularOscillatingDisplacement`` on the plate), so that the inflow, outflow and sides stay where they are.
+``--dof static`` turns the plate to ``--angle`` the same way in the first step and holds it there: the steady
+C_D, C_L, C_M (averaged over the last quarter of ``--duration``) beside the thin plate's potential flow, a
+reference for ``bridge.aero.static``.
 
 Needs OpenFOAM (ESI v1912 was used: Debian's package ``openfoam``, ``apt-get install openfoam``); not a
 dependency of the project.  Writes the case to ``--out`` (default out/openfoam_plate/<case>), runs
@@ -162,7 +166,9 @@ def block_mesh_dict(edge: float, thickness: float, growth: float) -> tuple[str, 
 
 def write_case(case: Path, dof: str, K: float, amplitude: float, reynolds: float, thickness: float,
                edge: float, growth: float, end_time: float, write_interval: float, procs: int, max_co: float,
-               turbulence: str = "laminar") -> int:
+               turbulence: str = "laminar", angle: float = 0.0) -> int:
+    """The case folder; ``dof`` heave or pitch (``amplitude`` in chords or rad at ``K``), or static: the plate
+    held at ``angle`` (rad, nose-up), turned there in the first step."""
     for sub in ("system", "constant", "0"):
         (case / sub).mkdir(parents=True, exist_ok=True)
     mesh, cells = block_mesh_dict(edge, thickness, growth)
@@ -290,7 +296,7 @@ boundaryField
     frontAndBack { type empty; }
 }
 """)
-    if dof == "pitch":
+    if dof in ("pitch", "static"):
         # nose-up is clockwise: a negative rotation about z
         header = HEADER.format(cls="pointVectorField", obj="pointDisplacement")
         (case / "0" / "pointDisplacement").write_text(header + f"""
@@ -304,7 +310,7 @@ boundaryField
         type angularOscillatingDisplacement;
         axis (0 0 -1);
         origin (0 0 0);
-        angle0 0;
+        angle0 {angle:.12g};
         amplitude {amplitude:.12g};
         omega {K:.12g};
         value uniform (0 0 0);
@@ -464,10 +470,30 @@ def derivatives(dof: str, K: float, amplitude: float, forces: dict, discard: int
     return out
 
 
+def static_coefficients(angle: float, forces: dict, average_from: float) -> dict:
+    """Drag, lift (wind axes: the stream is along x) and nose-up moment about the mid-chord per 1/2 rho V^2 B
+    (and B^2), averaged from ``average_from`` on, with their standard deviation there (the flow's
+    unsteadiness), beside the thin plate's potential-flow 2 pi alpha and pi alpha / 2."""
+    sel = forces["t"] >= average_from
+    if not sel.any():
+        raise SystemExit(f"no forces after t = {average_from:g}: the run ended at {forces['t'][-1]:g}")
+    series = {"C_D": 2 * forces["fx"][sel], "C_L": 2 * forces["fy"][sel], "C_M": -2 * forces["mz"][sel]}
+    out = {name: {"mean": float(v.mean()), "std": float(v.std())} for name, v in series.items()}
+    out["C_L"]["potential_flow"] = 2 * math.pi * angle
+    out["C_M"]["potential_flow"] = math.pi * angle / 2
+    for name in ("C_L", "C_M"):
+        out[name]["ratio"] = out[name]["mean"] / out[name]["potential_flow"] if angle else float("nan")
+    return out
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--reduced-velocity", type=float, default=4.0, help="U/(fB) (default 4)")
-    ap.add_argument("--dof", choices=("heave", "pitch"), default="heave")
+    ap.add_argument("--dof", choices=("heave", "pitch", "static"), default="heave",
+                    help="forced heave or pitch, or static: the plate held at --angle (steady coefficients)")
+    ap.add_argument("--angle", type=float, default=2.0, help="static: angle of attack, degrees (default 2)")
+    ap.add_argument("--duration", type=float, default=20.0,
+                    help="static: B/V run (default 20, as bridge.aero.static); the last quarter is averaged")
     ap.add_argument("--edge-cell", type=float, default=0.0025, help="cell at the plate, chords (default 0.0025)")
     ap.add_argument("--growth", type=float, default=1.05, help="largest cell-to-cell growth (default 1.05)")
     ap.add_argument("--reynolds", type=float, default=1000.0, help="V B / nu (default 1000, the standard preset)")
@@ -485,11 +511,14 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     for name, value, lo in (("--reduced-velocity", args.reduced_velocity, 0.0), ("--edge-cell", args.edge_cell, 0.0),
                             ("--reynolds", args.reynolds, 0.0), ("--thickness", args.thickness, 0.0),
-                            ("--amplitude-scale", args.amplitude_scale, 0.0), ("--max-co", args.max_co, 0.0)):
+                            ("--amplitude-scale", args.amplitude_scale, 0.0), ("--max-co", args.max_co, 0.0),
+                            ("--duration", args.duration, 0.0)):
         if not value > lo:
             ap.error(f"{name}: must be > {lo:g}, got {value:g}")
     if not 1.0 < args.growth <= 1.3:
         ap.error(f"--growth: must be in (1, 1.3], got {args.growth:g}")
+    if not abs(args.angle) <= 20.0:
+        ap.error(f"--angle: must be in [-20, 20] degrees, got {args.angle:g}")
     if not 0 <= args.discard < args.periods:
         ap.error(f"--discard: must be in [0, --periods), got {args.discard}")
     if not args.mesh_only:
@@ -499,11 +528,14 @@ def main(argv=None) -> int:
             print(f"error: {', '.join(missing)} not found: install OpenFOAM (apt-get install openfoam)",
                   file=sys.stderr)
             return 2
+    tail = ("_sst" if args.turbulence == "sst" else "")
+    grid = f"Re{args.reynolds:g}_t{args.thickness:g}_e{args.edge_cell:g}_g{args.growth:g}"
+    if args.dof == "static":
+        return _static(args, f"static_a{args.angle:g}_{grid}{tail}")
     K = 2 * math.pi / args.reduced_velocity
     rate = THESIS_HEAVE_RATE if args.dof == "heave" else THESIS_PITCH_RATE
     amplitude = args.amplitude_scale * rate / K
-    name = (f"{args.dof}_U{args.reduced_velocity:g}_Re{args.reynolds:g}_t{args.thickness:g}_e{args.edge_cell:g}"
-            f"_g{args.growth:g}_a{args.amplitude_scale:g}" + ("_sst" if args.turbulence == "sst" else ""))
+    name = f"{args.dof}_U{args.reduced_velocity:g}_{grid}_a{args.amplitude_scale:g}{tail}"
     case = args.out or Path("out") / "openfoam_plate" / name
     T = 2 * math.pi / K
     end_time = args.periods * T
@@ -515,17 +547,43 @@ def main(argv=None) -> int:
         return 0
     wall = run(case, args.procs, end_time)
     forces = read_forces(case)
-    result = {"case": name, "dof": args.dof, "reduced_velocity": args.reduced_velocity, "K": K,
-              "reynolds": args.reynolds, "turbulence": args.turbulence, "thickness": args.thickness,
-              "edge_cell": args.edge_cell,
-              "growth": args.growth, "cells": cells, "amplitude": amplitude, "steps": int(forces["t"].size),
-              "wall_s": wall, **derivatives(args.dof, K, amplitude, forces, args.discard)}
+    result = {"case": name, **_common(args, cells, forces, wall), "reduced_velocity": args.reduced_velocity,
+              "K": K, "amplitude": amplitude, **derivatives(args.dof, K, amplitude, forces, args.discard)}
     (case / "result.json").write_text(json.dumps(result, indent=1))
     print(f"{cells} cells, {forces['t'].size} steps, {wall:.0f} s; {result['periods_fitted']} periods fitted")
     for n in DERIVATIVES[args.dof]:
         r = result[n]
         print(f"  {n}*: OpenFOAM {r['openfoam']:+.4f}, Theodorsen {r['theodorsen']:+.4f} "
               f"({100 * r['relative_difference']:+.1f} %)")
+    return 0
+
+
+def _common(args, cells: int, forces: dict, wall: float) -> dict:
+    return {"dof": args.dof, "reynolds": args.reynolds, "turbulence": args.turbulence, "thickness": args.thickness,
+            "edge_cell": args.edge_cell, "growth": args.growth, "cells": cells, "steps": int(forces["t"].size),
+            "wall_s": wall}
+
+
+def _static(args, name: str) -> int:
+    """The plate held at --angle for --duration B/V; the coefficients averaged over the last quarter."""
+    angle = math.radians(args.angle)
+    case = args.out or Path("out") / "openfoam_plate" / name
+    cells = write_case(case, "static", 1.0, 0.0, args.reynolds, args.thickness, args.edge_cell, args.growth,
+                       args.duration, args.duration / 4, args.procs, args.max_co, args.turbulence, angle=angle)
+    print(f"{name}: {cells} cells, held at {args.angle:g} deg for {args.duration:g} B/V; case in {case}",
+          flush=True)
+    if args.mesh_only:
+        return 0
+    wall = run(case, args.procs, args.duration)
+    forces = read_forces(case)
+    coefficients = static_coefficients(angle, forces, 0.75 * args.duration)
+    result = {"case": name, **_common(args, cells, forces, wall), "angle_deg": args.angle,
+              "duration": args.duration, **coefficients}
+    (case / "result.json").write_text(json.dumps(result, indent=1))
+    print(f"{cells} cells, {forces['t'].size} steps, {wall:.0f} s; averaged over t >= {0.75 * args.duration:g}")
+    for n, c in coefficients.items():
+        ref = (f", {c['ratio']:.3f} x potential flow's {c['potential_flow']:+.4f}" if "ratio" in c else "")
+        print(f"  {n}: {c['mean']:+.4f} (sd {c['std']:.1e}){ref}")
     return 0
 
 

@@ -123,3 +123,26 @@ def test_a_restart_from_the_same_time_reads_the_newer_force_file(tmp_path):
     f = of.read_forces(tmp_path)
     assert list(f["t"]) == [0.1, 0.2, 0.3, 0.4]
     assert list(f["fy"]) == [2.0] * 4 and list(f["fx"]) == [4.0] * 4 and list(f["mz"]) == [6.0] * 4
+
+
+def test_the_static_case_holds_the_plate_at_its_angle_and_averages_the_coefficients(tmp_path):
+    """--dof static: the pitch machinery with no oscillation and the plate turned nose-up by the angle
+    (angle0 about -z); the coefficients are the means over the averaging window, per 1/2 rho V^2 B."""
+    of = load_tool("openfoam_plate")
+    angle = math.radians(2.0)
+    of.write_case(tmp_path / "s", "static", 1.0, 0.0, 1e6, 0.02, 0.01, 1.05, 20.0, 5.0, 2, 1.0, "sst",
+                  angle=angle)
+    text = (tmp_path / "s" / "0" / "pointDisplacement").read_text()
+    assert f"angle0 {angle:.12g};" in text and "amplitude 0;" in text and "axis (0 0 -1);" in text
+    assert "displacementLaplacian" in (tmp_path / "s" / "constant" / "dynamicMeshDict").read_text()
+    t = np.linspace(0.0, 20.0, 2001)
+    transient = np.exp(-t)                       # gone by the last quarter
+    forces = {"t": t, "fx": 0.012 + transient, "fy": 0.5 * 0.9 * 2 * math.pi * angle + transient,
+              "mz": -0.5 * 0.95 * math.pi * angle / 2 + transient}
+    c = of.static_coefficients(angle, forces, 15.0)
+    assert c["C_D"]["mean"] == pytest.approx(0.024, rel=1e-5)
+    assert c["C_L"]["ratio"] == pytest.approx(0.9, rel=1e-5)
+    assert c["C_M"]["ratio"] == pytest.approx(0.95, rel=1e-5)
+    assert c["C_L"]["std"] < 1e-6
+    with pytest.raises(SystemExit):
+        of.static_coefficients(angle, forces, 21.0)
