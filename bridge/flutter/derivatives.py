@@ -33,7 +33,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-__all__ = ["FRF", "FlutterDerivatives", "frf_from_derivatives", "derivatives_from_frf", "FRF_NAMES",
+__all__ = ["FRF", "FlutterDerivatives", "frf_from_derivatives", "derivatives_from_frf", "scale_derivative", "FRF_NAMES",
            "DERIVATIVE_NAMES", "VERTICAL_TORSIONAL", "LATERAL"]
 
 
@@ -104,3 +104,15 @@ def derivatives_from_frf(K: np.ndarray, h: FRF) -> FlutterDerivatives:
         v = sign * np.asarray(getattr(h, name), dtype=np.complex128) / K2
         out[re], out[im] = v.real, v.imag
     return FlutterDerivatives(**out)
+
+
+def scale_derivative(h: FRF, name: str, factor: float) -> FRF:
+    """``h`` with Scanlan's derivative ``name`` (e.g. "A2") times ``factor`` and every other derivative as it
+    was: the one part (real or imaginary) of the one h_xy that carries it, scaled (the module docstring's
+    table; exact at every Omega, 0 included)."""
+    for frf_name, (_, re, im) in _MAP.items():
+        if name in (re, im):
+            v = np.asarray(getattr(h, frf_name), dtype=np.complex128)
+            v = (factor * v.real + 1j * v.imag) if name == re else (v.real + 1j * factor * v.imag)
+            return h._replace(**{frf_name: v})
+    raise ValueError(f"{name!r} is not one of Scanlan's derivatives ({', '.join(DERIVATIVE_NAMES)})")

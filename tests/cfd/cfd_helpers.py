@@ -2,6 +2,7 @@
 import it by name) and the devices to run kernel tests on (cuda only when present)."""
 
 import importlib.util
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -56,5 +57,6 @@ def load_tool(name: str):
     path = Path(__file__).resolve().parents[2] / "tools" / f"{name}.py"
     spec = importlib.util.spec_from_file_location(name, path)
     mod = importlib.util.module_from_spec(spec)
+    sys.modules[name] = mod         # where a dataclass of the tool looks its module up
     spec.loader.exec_module(mod)
     return mod
