@@ -21,7 +21,7 @@ the SST runs of `python tools/validate_aero.py --turbulence sst` (docs/aero.md).
 Heave is a rigid translation of the whole mesh (``oscillatingLinearMotion``).  Pitch rotates the plate's
 surface about its mid-chord and deforms the mesh around it (``displacementLaplacian`` with
 ``angularOscillatingDisplacement`` on the plate), so that the inflow, outflow and sides stay where they are.
-``--dof static`` turns the plate to ``--angle`` the same way in the first step and holds it there: the steady
+``--dof static`` turns the plate to ``--angle`` the same way (over the first B/V) and holds it there: the steady
 C_D, C_L, C_M (averaged over the last quarter of ``--duration``) beside the thin plate's potential flow, a
 reference for ``bridge.aero.static``.
 
@@ -168,7 +168,7 @@ def write_case(case: Path, dof: str, K: float, amplitude: float, reynolds: float
                edge: float, growth: float, end_time: float, write_interval: float, procs: int, max_co: float,
                turbulence: str = "laminar", angle: float = 0.0) -> int:
     """The case folder; ``dof`` heave or pitch (``amplitude`` in chords or rad at ``K``), or static: the plate
-    held at ``angle`` (rad, nose-up), turned there in the first step."""
+    held at ``angle`` (rad, nose-up), turned there over the first STATIC_RAMP."""
     for sub in ("system", "constant", "0"):
         (case / sub).mkdir(parents=True, exist_ok=True)
     mesh, cells = block_mesh_dict(edge, thickness, growth)
@@ -296,7 +296,9 @@ boundaryField
     frontAndBack { type empty; }
 }
 """)
-    if dof in ("pitch", "static"):
+    if dof == "static":
+        _write_static_rotation(case, angle, end_time, far)
+    elif dof == "pitch":
         # nose-up is clockwise: a negative rotation about z
         header = HEADER.format(cls="pointVectorField", obj="pointDisplacement")
         (case / "0" / "pointDisplacement").write_text(header + f"""
@@ -310,7 +312,7 @@ boundaryField
         type angularOscillatingDisplacement;
         axis (0 0 -1);
         origin (0 0 0);
-        angle0 {angle:.12g};
+        angle0 0;
         amplitude {amplitude:.12g};
         omega {K:.12g};
         value uniform (0 0 0);
@@ -319,6 +321,38 @@ boundaryField
 }}
 """)
     return cells
+
+
+STATIC_RAMP = 1.0   # B/V over which the static case turns the plate to its angle
+
+
+def _write_static_rotation(case: Path, angle: float, end_time: float, far: str) -> None:
+    """The plate turned nose-up (clockwise: a negative rotation about z) to ``angle`` along a half-cosine over
+    STATIC_RAMP, then held (``tabulated6DoFMotion`` on the plate's points, the mesh deformed round it).  Turned
+    in one step instead, the plate's edges moved at 15 V on the 0.005-chord mesh and the solver failed."""
+    times = np.linspace(0.0, STATIC_RAMP, 21)
+    degrees = -math.degrees(angle) * 0.5 * (1.0 - np.cos(np.pi * times / STATIC_RAMP))
+    rows = [(t, d) for t, d in zip(times, degrees, strict=True)] + [(max(end_time, STATIC_RAMP) + 1.0, degrees[-1])]
+    (case / "constant" / "rotation.dat").write_text(
+        f"{len(rows)}\n(\n" + "".join(f"({t:.12g} ((0 0 0) (0 0 {d:.12g})))\n" for t, d in rows) + ")\n")
+    header = HEADER.format(cls="pointVectorField", obj="pointDisplacement")
+    (case / "0" / "pointDisplacement").write_text(header + f"""
+dimensions [0 1 0 0 0 0 0];
+internalField uniform (0 0 0);
+boundaryField
+{{
+    "({far})" {{ type fixedValue; value uniform (0 0 0); }}
+    plate
+    {{
+        type solidBodyMotionDisplacement;
+        solidBodyMotionFunction tabulated6DoFMotion;
+        CofG (0 0 0);
+        timeDataFileName "$FOAM_CASE/constant/rotation.dat";
+        value uniform (0 0 0);
+    }}
+    frontAndBack {{ type empty; }}
+}}
+""")
 
 
 def _write_turbulence_fields(case: Path, reynolds: float) -> None:

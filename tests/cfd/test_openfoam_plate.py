@@ -126,15 +126,24 @@ def test_a_restart_from_the_same_time_reads_the_newer_force_file(tmp_path):
 
 
 def test_the_static_case_holds_the_plate_at_its_angle_and_averages_the_coefficients(tmp_path):
-    """--dof static: the pitch machinery with no oscillation and the plate turned nose-up by the angle
-    (angle0 about -z); the coefficients are the means over the averaging window, per 1/2 rho V^2 B."""
+    """--dof static: the plate's points turned nose-up (clockwise: negative degrees about z) along a smooth
+    ramp to the angle and held past the end; the mesh deforms round it; the coefficients are the means over
+    the averaging window, per 1/2 rho V^2 B."""
     of = load_tool("openfoam_plate")
     angle = math.radians(2.0)
     of.write_case(tmp_path / "s", "static", 1.0, 0.0, 1e6, 0.02, 0.01, 1.05, 20.0, 5.0, 2, 1.0, "sst",
                   angle=angle)
     text = (tmp_path / "s" / "0" / "pointDisplacement").read_text()
-    assert f"angle0 {angle:.12g};" in text and "amplitude 0;" in text and "axis (0 0 -1);" in text
+    assert "solidBodyMotionDisplacement" in text and "tabulated6DoFMotion" in text and "CofG (0 0 0);" in text
     assert "displacementLaplacian" in (tmp_path / "s" / "constant" / "dynamicMeshDict").read_text()
+    rows = (tmp_path / "s" / "constant" / "rotation.dat").read_text().splitlines()
+    assert int(rows[0]) == len(rows) - 3 and rows[1] == "(" and rows[-1] == ")"
+    table = np.array([of._numbers(r) for r in rows[2:-1]])        # t, translation, rotation (degrees)
+    assert np.all(table[:, 1:6] == 0.0) and table[0, 0] == 0.0 and table[0, 6] == 0.0
+    assert np.all(np.diff(table[:, 0]) > 0) and np.all(np.diff(table[:, 6]) <= 0)    # turning one way only
+    assert table[-1, 0] > 20.0 and table[-1, 6] == pytest.approx(-2.0, abs=1e-12)
+    ramp = table[np.searchsorted(table[:, 0], of.STATIC_RAMP), 6]
+    assert ramp == pytest.approx(-2.0, abs=1e-12)                   # at the angle after the ramp
     t = np.linspace(0.0, 20.0, 2001)
     transient = np.exp(-t)                       # gone by the last quarter
     forces = {"t": t, "fx": 0.012 + transient, "fy": 0.5 * 0.9 * 2 * math.pi * angle + transient,
