@@ -191,6 +191,8 @@ def main(argv=None) -> int:
         ap.error(f"--reynolds: {args.reynolds} not allowed; allowed: 1 .. 1e10")
     if args.threads is not None and not 1 <= args.threads <= 64:
         ap.error(f"--threads: {args.threads} not allowed; allowed: 1 .. 64")
+    if args.out.is_dir():   # found before the runs, not when writing their table at the end
+        ap.error(f"--out: {args.out} is a folder; give the JSON file to write (e.g. {args.out / 'validate_aero.json'})")
     overrides = {k: getattr(args, k) for k in GRID_FIELDS}
     try:   # the preset checks the replaced fields: a bad value stops here, before any run
         q = plate_quality(args.quality, args.grid, args.turbulence, args.reynolds, overrides)

@@ -33,6 +33,17 @@ def test_a_bad_override_exits_2_naming_the_field_and_writes_nothing(tmp_path, ca
     assert not out.exists() and not (tmp_path / "validate_aero_runs").exists()
 
 
+def test_an_out_that_is_a_folder_is_refused_before_any_run(tmp_path, capsys):
+    """--out names the JSON file; a folder there once ended a 50-minute run with IsADirectoryError when the
+    table was written."""
+    va = load_tool("validate_aero")
+    with pytest.raises(SystemExit) as e:
+        va.main(["--quality", "tiny", "--out", str(tmp_path)])
+    assert e.value.code == 2
+    assert "--out" in capsys.readouterr().err
+    assert not (tmp_path.parent / "validate_aero_runs").exists()
+
+
 def test_heave_alone_gives_its_four_derivatives_and_none_for_the_pitch_ones(tmp_path):
     import json
     import math
