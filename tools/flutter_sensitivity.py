@@ -37,6 +37,7 @@ from bridge.files import atomic_write_text  # noqa: E402
 from bridge.flutter.derivatives import DERIVATIVE_NAMES, scale_derivative  # noqa: E402
 from bridge.flutter.determinant import governing, solve_pair  # noqa: E402
 from bridge.flutter.options import FlutterOptions  # noqa: E402
+from bridge.flutter.stage import options_and_aerodynamics  # noqa: E402
 from bridge.pipeline import run_stages  # noqa: E402
 from bridge.stages import RunOptions  # noqa: E402
 
@@ -154,14 +155,7 @@ def _run(args) -> int:
     options = RunOptions(progress=lambda m: print(m, flush=True), cache=args.cache, quality=args.quality)
     outputs = run_stages(scenario, ["flutter"], options)
     flutter = outputs["flutter"].data
-    fopts: FlutterOptions = getattr(scenario, "flutter", None) or FlutterOptions()
-    section = getattr(scenario, "section", None) if getattr(scenario, "kind", None) == "section" else None
-    if section is not None and section.aerodynamics is not None:
-        from dataclasses import replace
-        fopts = replace(fopts, aerodynamics=section.aerodynamics)
-    src = getattr(scenario, "source_path", None)
-    cfd = outputs["aero"].data.model if "aero" in outputs else None
-    aero = fopts.aerodynamic_model(Path(src).parent if src else None, cfd=cfd)
+    fopts, aero = options_and_aerodynamics(scenario, outputs)    # as the flutter stage built them
     modal, rho = flutter.modal_model, flutter.air_density_kg_m3
 
     v0, f0, pair0 = critical(modal, aero, rho, fopts)

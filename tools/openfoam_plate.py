@@ -527,7 +527,7 @@ def main(argv=None) -> int:
                     help="forced heave or pitch, or static: the plate held at --angle (steady coefficients)")
     ap.add_argument("--angle", type=float, default=2.0, help="static: angle of attack, degrees (default 2)")
     ap.add_argument("--duration", type=float, default=20.0,
-                    help="static: B/V run (default 20, as bridge.aero.static); the last quarter is averaged")
+                    help="static: B/V run (default 20); the last quarter is averaged")
     ap.add_argument("--edge-cell", type=float, default=0.0025, help="cell at the plate, chords (default 0.0025)")
     ap.add_argument("--growth", type=float, default=1.05, help="largest cell-to-cell growth (default 1.05)")
     ap.add_argument("--reynolds", type=float, default=1000.0, help="V B / nu (default 1000, the standard preset)")

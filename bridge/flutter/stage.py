@@ -101,15 +101,21 @@ def _air_density(scenario: Any, fopts: FlutterOptions) -> float:
     return 1.225
 
 
-def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
+def options_and_aerodynamics(scenario: Any, upstream: dict) -> tuple[FlutterOptions, Any]:
+    """The scenario's flutter options (a [section]'s aerodynamics taking the place of [flutter]'s) and the
+    aerodynamic model they name (tables read from the scenario's folder; the aero stage's in ``upstream``)."""
     fopts: FlutterOptions = getattr(scenario, "flutter", None) or FlutterOptions()
-    modal, source = _modes(scenario, upstream)
     section = getattr(scenario, "section", None) if getattr(scenario, "kind", None) == "section" else None
     if section is not None and section.aerodynamics is not None:
         fopts = replace(fopts, aerodynamics=section.aerodynamics)
     src = getattr(scenario, "source_path", None)
     cfd = upstream["aero"].data.model if "aero" in upstream else None
-    aero = fopts.aerodynamic_model(Path(src).parent if src else None, cfd=cfd)
+    return fopts, fopts.aerodynamic_model(Path(src).parent if src else None, cfd=cfd)
+
+
+def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
+    fopts, aero = options_and_aerodynamics(scenario, upstream)
+    modal, source = _modes(scenario, upstream)
     rho = _air_density(scenario, fopts)
     n_speed = min(fopts.speed_steps, QUICK_SPEED_STEPS) if options.quick else fopts.speed_steps
     kw = dict(min_speed_m_s=fopts.min_speed_m_s, n_speed=n_speed)
