@@ -298,28 +298,13 @@ boundaryField
 """)
     if dof == "static":
         _write_static_rotation(case, angle, end_time, far)
-    elif dof == "pitch":
-        # nose-up is clockwise: a negative rotation about z
-        header = HEADER.format(cls="pointVectorField", obj="pointDisplacement")
-        (case / "0" / "pointDisplacement").write_text(header + f"""
-dimensions [0 1 0 0 0 0 0];
-internalField uniform (0 0 0);
-boundaryField
-{{
-    "({far})" {{ type fixedValue; value uniform (0 0 0); }}
-    plate
-    {{
-        type angularOscillatingDisplacement;
+    elif dof == "pitch":    # nose-up is clockwise: a negative rotation about z
+        _write_point_displacement(case, far, f"""type angularOscillatingDisplacement;
         axis (0 0 -1);
         origin (0 0 0);
         angle0 0;
         amplitude {amplitude:.12g};
-        omega {K:.12g};
-        value uniform (0 0 0);
-    }}
-    frontAndBack {{ type empty; }}
-}}
-""")
+        omega {K:.12g};""")
     return cells
 
 
@@ -335,6 +320,15 @@ def _write_static_rotation(case: Path, angle: float, end_time: float, far: str) 
     rows = [(t, d) for t, d in zip(times, degrees, strict=True)] + [(max(end_time, STATIC_RAMP) + 1.0, degrees[-1])]
     (case / "constant" / "rotation.dat").write_text(
         f"{len(rows)}\n(\n" + "".join(f"({t:.12g} ((0 0 0) (0 0 {d:.12g})))\n" for t, d in rows) + ")\n")
+    _write_point_displacement(case, far, """type solidBodyMotionDisplacement;
+        solidBodyMotionFunction tabulated6DoFMotion;
+        CofG (0 0 0);
+        timeDataFileName "$FOAM_CASE/constant/rotation.dat";""")
+
+
+def _write_point_displacement(case: Path, far: str, plate: str) -> None:
+    """0/pointDisplacement of the deforming mesh: the far boundaries fixed, the plate's points moved as
+    ``plate`` (its boundary entry without the value) says."""
     header = HEADER.format(cls="pointVectorField", obj="pointDisplacement")
     (case / "0" / "pointDisplacement").write_text(header + f"""
 dimensions [0 1 0 0 0 0 0];
@@ -344,10 +338,7 @@ boundaryField
     "({far})" {{ type fixedValue; value uniform (0 0 0); }}
     plate
     {{
-        type solidBodyMotionDisplacement;
-        solidBodyMotionFunction tabulated6DoFMotion;
-        CofG (0 0 0);
-        timeDataFileName "$FOAM_CASE/constant/rotation.dat";
+        {plate}
         value uniform (0 0 0);
     }}
     frontAndBack {{ type empty; }}
