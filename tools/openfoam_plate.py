@@ -23,7 +23,8 @@ surface about its mid-chord and deforms the mesh around it (``displacementLaplac
 ``angularOscillatingDisplacement`` on the plate), so that the inflow, outflow and sides stay where they are.
 ``--dof static`` turns the plate to ``--angle`` the same way (over the first B/V) and holds it there: the steady
 C_D, C_L, C_M (averaged over the last quarter of ``--duration``) beside the thin plate's potential flow, a
-reference for ``bridge.aero.static``.
+reference for ``bridge.aero.static``, and the pressure along the chord at the end (:func:`plate_loading`;
+``tools/plate_loading.py --openfoam CASE`` puts it beside ours).
 
 Needs OpenFOAM (ESI v1912 was used: Debian's package ``openfoam``, ``apt-get install openfoam``); not a
 dependency of the project.  Writes the case to ``--out`` (default out/openfoam_plate/<case>), runs
@@ -495,6 +496,108 @@ def derivatives(dof: str, K: float, amplitude: float, forces: dict, discard: int
     return out
 
 
+# ---------------------------------------------------------------------------------------------- the plate's pressure
+
+
+def _foam_body(path: Path) -> tuple[bytes, bool]:
+    """The bytes of an OpenFOAM file after its FoamFile header, and whether it is written in binary."""
+    raw = path.read_bytes()
+    head = raw.index(b"FoamFile")
+    end = raw.index(b"}", head)
+    return raw[end + 1:], re.search(rb"format\s+binary", raw[head:end]) is not None
+
+
+def _foam_list(data: bytes, binary: bool, dtype, width: int = 1, start: int = 0) -> tuple[np.ndarray, int]:
+    """The first ``N ( ... )`` list at or after ``start`` (N items of ``width`` numbers) and where it ends."""
+    m = re.compile(rb"(\d+)\s*\(").search(data, start)
+    if m is None:
+        raise ValueError("no list found")
+    n, i = int(m.group(1)), m.end()
+    if binary:
+        values = np.frombuffer(data, dtype=dtype, count=n * width, offset=i)
+        return values.reshape(n, width) if width > 1 else values, i + values.nbytes + 1
+    depth, j = 1, i
+    while depth:
+        depth += {40: 1, 41: -1}.get(data[j], 0)   # "(" and ")"
+        j += 1
+    text = data[i:j - 1].replace(b"(", b" ").replace(b")", b" ").split()
+    values = np.array(text, dtype=dtype)
+    if values.size != n * width:
+        raise ValueError(f"a list of {n} x {width} holds {values.size} numbers")
+    return values.reshape(n, width) if width > 1 else values, j
+
+
+def _foam_faces(path: Path) -> tuple[np.ndarray, np.ndarray]:
+    """A mesh's faces as (offsets, point labels): a faceCompactList (binary, as this tool's cases write it) or
+    an ascii faceList (``N ( 4(a b c d) ... )``, as foamFormatConvert to ascii writes it)."""
+    data, binary = _foam_body(path)
+    if binary or b"faceCompactList" in path.read_bytes()[:2000]:
+        offsets, end = _foam_list(data, binary, "<i4")
+        labels, _ = _foam_list(data, binary, "<i4", start=end)
+        return offsets, labels
+    m = re.compile(rb"(\d+)\s*\(").search(data)
+    faces = [np.array(f.split(), dtype=np.int32) for f in re.findall(rb"\d+\s*\(([^()]*)\)", data[m.end():])]
+    if len(faces) != int(m.group(1)):
+        raise ValueError(f"{path}: {len(faces)} faces read, {int(m.group(1))} announced")
+    return np.concatenate([[0], np.cumsum([f.size for f in faces])]), np.concatenate(faces)
+
+
+def plate_surface_pressure(case: Path, time: str | None = None) -> dict:
+    """The pressure on the plate's upper and lower faces at ``time`` (default: the latest written), as C_p.
+
+    The plate turns as a rigid body, so its faces keep their places in the mesh as written at the start
+    (constant/polyMesh), which is the plate's own frame: x from the leading edge in chords, the upper side at
+    y > 0.  The wall takes its cell's pressure (zeroGradient; OpenFOAM's p is per density, the reference that of
+    the outflow).  Returns ``x``, ``width`` (the face's extent along the chord) and ``cp`` for each side."""
+    case = Path(case)
+    times = sorted((d for d in case.iterdir() if d.is_dir() and re.fullmatch(r"[0-9.eE+-]+", d.name)
+                    and (d / "p").is_file()), key=lambda d: float(d.name))
+    if time is None:
+        if not times:
+            raise SystemExit(f"{case}: no time folder with a pressure field")
+        folder = times[-1]
+    else:
+        folder = case / time
+    mesh = case / "constant" / "polyMesh"
+    pts, binary = _foam_body(mesh / "points")
+    points, _ = _foam_list(pts, binary, "<f8", 3)
+    offsets, labels = _foam_faces(mesh / "faces")
+    ob, binary = _foam_body(mesh / "owner")
+    owner, _ = _foam_list(ob, binary, "<i4")
+    boundary = (mesh / "boundary").read_text()
+    entry = re.search(r"\bplate\s*\{([^}]*)\}", boundary)
+    if entry is None:
+        raise SystemExit(f"{mesh / 'boundary'}: no patch 'plate'")
+    n = int(re.search(r"nFaces\s+(\d+)", entry.group(1)).group(1))
+    first = int(re.search(r"startFace\s+(\d+)", entry.group(1)).group(1))
+    pb, binary = _foam_body(folder / "p")
+    p, _ = _foam_list(pb, binary, "<f8", start=pb.index(b"internalField"))
+    faces = [labels[offsets[f]:offsets[f + 1]] for f in range(first, first + n)]
+    xs = [points[f, 0] for f in faces]
+    centre = np.array([points[f].mean(axis=0) for f in faces])
+    width = np.array([x.max() - x.min() for x in xs])
+    cp = p[owner[first:first + n]] / 0.5
+    flat = width > 1e-9                   # the upper and lower faces; the edges' faces have no extent along x
+    out = {"time": float(folder.name)}
+    for side, sel in (("upper", flat & (centre[:, 1] > 0)), ("lower", flat & (centre[:, 1] < 0))):
+        order = np.argsort(centre[sel, 0])
+        out[side] = {"x": centre[sel, 0][order] + 0.5, "width": width[sel][order], "cp": cp[sel][order]}
+    return out
+
+
+def plate_loading(case: Path, angle_deg: float, time: str | None = None) -> dict:
+    """Delta C_p along the chord from :func:`plate_surface_pressure`, the upper faces' pressure taken at the
+    lower faces' x (the two sides' faces match on this mesh): ``x``, ``delta_cp``, ``time`` and ``loading``
+    (bridge.aero.static.chordwise_loading)."""
+    from bridge.aero.static import chordwise_loading
+
+    s = plate_surface_pressure(case, time)
+    up, lo = s["upper"], s["lower"]
+    delta = lo["cp"] - np.interp(lo["x"], up["x"], up["cp"])
+    return {"x": lo["x"], "delta_cp": delta, "time": s["time"],
+            "loading": chordwise_loading(lo["x"], delta, lo["width"], math.radians(angle_deg))}
+
+
 def static_coefficients(angle: float, forces: dict, average_from: float) -> dict:
     """Drag, lift (wind axes: the stream is along x) and nose-up moment about the mid-chord per 1/2 rho V^2 B
     (and B^2), averaged from ``average_from`` on, with their standard deviation there (the flow's
@@ -604,11 +707,18 @@ def _static(args, name: str) -> int:
     coefficients = static_coefficients(angle, forces, 0.75 * args.duration)
     result = {"case": name, **_common(args, cells, forces, wall), "angle_deg": args.angle,
               "duration": args.duration, **coefficients}
+    if args.angle:   # where along the chord the plate carries its lift (tools/plate_loading.py compares ours)
+        loading = plate_loading(case, args.angle)["loading"]
+        result["loading"] = loading.as_dict()
     (case / "result.json").write_text(json.dumps(result, indent=1))
     print(f"{cells} cells, {forces['t'].size} steps, {wall:.0f} s; averaged over t >= {0.75 * args.duration:g}")
     for n, c in coefficients.items():
         ref = (f", {c['ratio']:.3f} x potential flow's {c['potential_flow']:+.4f}" if "ratio" in c else "")
         print(f"  {n}: {c['mean']:+.4f} (sd {c['std']:.1e}){ref}")
+    if "loading" in result:
+        print(f"  from the plate's pressure at t = {args.duration:g}: C_L {loading.lift:+.4f}, "
+              f"C_M {loading.moment:+.4f}, centre of pressure {loading.centre_of_pressure:.3f} chords from the "
+              "leading edge")
     return 0
 
 

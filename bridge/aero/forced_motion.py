@@ -361,7 +361,8 @@ def _load_checkpoint(path: Path, key: str, flow) -> dict | None:
 
 def run_case(shape, case: ForcedCase | StaticCase, quality: Quality, checkpoint: Path | None = None,
              checkpoint_every: int = 2000, threads: int | None = None,
-             progress: Callable[[str], None] | None = None, label: str = "") -> ForceRecord:
+             progress: Callable[[str], None] | None = None, label: str = "",
+             observe: Callable[[object], None] | None = None) -> ForceRecord:
     """Run one case - forced motion for :meth:`ForcedCase.end_time` (the caller drops the first
     :meth:`ForcedCase.discarded_periods`, :func:`whole_periods`), or a section held still for
     ``quality.static_duration`` - and return the whole force record.  ``shape``: the section's polygon,
@@ -369,7 +370,10 @@ def run_case(shape, case: ForcedCase | StaticCase, quality: Quality, checkpoint:
     ``checkpoint`` if it holds this case (:func:`case_key`); progress lines about every 10 % of the run.
     ``threads``: CPU threads of the step (default 2, but 1 below 20 000 cells, where waiting for the second thread
     costs more than it saves; the numbers do not depend on it).  A run whose flow stops being finite
-    raises DivergedError (exit status 3); a section the preset's grid cannot hold, InputError (2)."""
+    raises DivergedError (exit status 3); a section the preset's grid cannot hold, InputError (2).
+    ``observe``: called with the flow after every step (after a resume: every step run here) - for a diagnostic
+    that needs the fields, such as the plate's surface pressure of tools/plate_loading.py; on the overset grid
+    the flow is a ``bridge.cfd.OversetPair``, whose ``body`` simulation moves with the section."""
     from bridge.cfd import FlowDiverged
 
     q = quality
@@ -380,7 +384,7 @@ def run_case(shape, case: ForcedCase | StaticCase, quality: Quality, checkpoint:
         raise InputError("aero.quality", q.name, f"its {'overset' if q.overset else 'single'} grid cannot hold "
                          f"this section and motion ({err})") from None
     try:
-        return _march(flow, polys, case, q, checkpoint, checkpoint_every, progress, label)
+        return _march(flow, polys, case, q, checkpoint, checkpoint_every, progress, label, observe)
     except FlowDiverged as err:
         raise DivergedError(f"the CFD of {label or case}", str(err)) from None
 
@@ -475,7 +479,7 @@ def run_cases(shape, jobs, quality: Quality, checkpoint_every: int = 2000,
     return records
 
 
-def _march(flow, polys, case, q, checkpoint, checkpoint_every, progress, label) -> ForceRecord:
+def _march(flow, polys, case, q, checkpoint, checkpoint_every, progress, label, observe=None) -> ForceRecord:
     """Run ``flow`` to the case's end time, with checkpoints and progress (run_case)."""
     from bridge.cfd import FlowDiverged, NaNMonitor, ProgressNote
 
@@ -513,6 +517,8 @@ def _march(flow, polys, case, q, checkpoint, checkpoint_every, progress, label) 
         rec["motion"].append(case.displacement(flow.t))
         for nan, sim in zip(nans, flow.simulations, strict=True):
             nan(sim)
+        if observe is not None:
+            observe(flow)
         if checkpoint is not None and flow.n_steps % checkpoint_every == 0:
             _save_checkpoint(checkpoint, key, flow, rec)
         if note is not None:

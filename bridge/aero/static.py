@@ -15,6 +15,17 @@ at alpha = 0 and its slope; these are the inputs of the quasi-steady model
 (:meth:`StaticCoefficients.quasi_steady`), which completes the CFD's heave and pitch derivatives with
 the lateral (drag, sway) terms.
 
+Chordwise loading (a diagnostic of where a plate carries its lift, ``tools/plate_loading.py``): the pressure
+difference between the lower and the upper surface, Delta C_p(x) = (p_lower - p_upper) / ((1/2) rho V^2), x
+from the leading edge in chords.  For the thin plate in potential flow (Katz and Plotkin, Low-Speed
+Aerodynamics, 2nd ed. 2001, section 5.3)
+
+    Delta C_p(x) = 4 alpha sqrt((1 - x) / x),
+
+whose integral over a strip is 4 alpha [F(x1) - F(x0)], F(x) = sqrt(x (1 - x)) + arcsin(sqrt(x)): over the
+chord 2 pi alpha, with the centre of pressure at the quarter chord.  28 % of that lift lies on the first 5 %
+of the chord (:func:`thin_plate_loading`).
+
 Settling: an impulsively started section reaches its steady lift only as the starting vortex moves
 away (for a thin plate Wagner's function, 1 - 0.165 exp(-0.091 t V/B) - 0.335 exp(-0.6 t V/B)), so a
 finite run under-reads it; :attr:`StaticCoefficients.settling` reports the change of each mean between
@@ -32,7 +43,8 @@ from bridge.aero.forced_motion import ForceRecord
 
 SHEDDING_THRESHOLD = 1e-4   # lift coefficient rms below which a wake counts as steady
 
-__all__ = ["SHEDDING_THRESHOLD", "StaticCoefficients", "static_coefficients", "shedding_frequency", "window_mean"]
+__all__ = ["SHEDDING_THRESHOLD", "ChordwiseLoading", "StaticCoefficients", "chordwise_loading", "static_coefficients",
+           "shedding_frequency", "thin_plate_loading", "window_mean"]
 
 
 def window_mean(t: np.ndarray, x: np.ndarray, start: float, end: float | None = None) -> float:
@@ -136,3 +148,57 @@ def static_coefficients(records: list[ForceRecord], angles_deg, depth_over_chord
     return StaticCoefficients(np.asarray(angles_deg, dtype=float), arr[:, 0], arr[:, 1], arr[:, 2], arr[:, 3],
                               arr[:, 4], np.array(settle, dtype=float).reshape(-1, 3), float(depth_over_chord),
                               window)
+
+
+def thin_plate_loading(alpha: float, x0: float, x1: float) -> float:
+    """The thin plate's potential-flow loading integrated over the strip x0 <= x <= x1 of the chord (module doc):
+    its lift coefficient from that strip, 4 alpha [F(x1) - F(x0)]; ``alpha`` in radians, 0 <= x0 <= x1 <= 1."""
+    if not 0.0 <= x0 <= x1 <= 1.0:
+        raise ValueError(f"strip: need 0 <= x0 <= x1 <= 1, got {x0}, {x1}")
+
+    def F(x):
+        return math.sqrt(x * (1.0 - x)) + math.asin(math.sqrt(x))
+
+    return 4.0 * alpha * (F(x1) - F(x0))
+
+
+@dataclass(frozen=True)
+class ChordwiseLoading:
+    """Delta C_p summed over strips of the chord, with what the whole chord's loading gives."""
+
+    edges: np.ndarray        # strip edges, chords from the leading edge
+    strips: np.ndarray       # integral of Delta C_p over each strip (its share of C_L)
+    potential: np.ndarray    # the same for the thin plate in potential flow (thin_plate_loading)
+    lift: float              # C_L from the pressure alone (the chord's integral)
+    moment: float            # C_M about the mid-chord, nose-up, from the pressure alone
+    alpha: float             # radians
+
+    @property
+    def centre_of_pressure(self) -> float:
+        """Chords from the leading edge (0.25 for the thin plate in potential flow)."""
+        return 0.5 - self.moment / self.lift
+
+    def as_dict(self) -> dict:
+        return {"strip_edges": self.edges.tolist(), "strips": self.strips.tolist(),
+                "potential_flow_strips": self.potential.tolist(), "lift_from_pressure": self.lift,
+                "moment_from_pressure": self.moment, "centre_of_pressure": self.centre_of_pressure,
+                "alpha_rad": self.alpha}
+
+
+def chordwise_loading(x: np.ndarray, delta_cp: np.ndarray, width: np.ndarray, alpha: float,
+                      edges=(0.0, 0.05, 0.1, 0.2, 0.3, 0.5, 0.7, 0.9, 1.0)) -> ChordwiseLoading:
+    """Sum samples of Delta C_p (at ``x``, chords from the leading edge, each standing for a piece of chord
+    ``width``: a cell or a face) over the strips between ``edges``, beside the thin plate's potential flow at
+    ``alpha`` (radians); C_L and C_M (mid-chord, nose-up) of the whole chord from the same samples."""
+    x, dcp, w = (np.asarray(a, dtype=float) for a in (x, delta_cp, width))
+    if not x.shape == dcp.shape == w.shape or x.ndim != 1 or x.size == 0:
+        raise ValueError(f"x, delta_cp, width: need equal 1-d shapes, got {x.shape}, {dcp.shape}, {w.shape}")
+    e = np.asarray(edges, dtype=float)
+    if e[0] != 0.0 or e[-1] != 1.0 or np.any(np.diff(e) <= 0):
+        raise ValueError(f"edges: need 0 = e0 < e1 < ... = 1, got {e.tolist()}")
+    load = dcp * w
+    strip = np.clip(np.searchsorted(e, x, side="right") - 1, 0, e.size - 2)
+    strips = np.bincount(strip, weights=load, minlength=e.size - 1)
+    potential = np.array([thin_plate_loading(alpha, a, b) for a, b in zip(e[:-1], e[1:], strict=True)])
+    return ChordwiseLoading(edges=e, strips=strips, potential=potential, lift=float(load.sum()),
+                            moment=float(-(load * (x - 0.5)).sum()), alpha=float(alpha))

@@ -14,7 +14,13 @@ import pytest
 from bridge.aero.forced_motion import QUALITY, ForceRecord, StaticCase, run_case
 from bridge.aero.options import AeroOptions
 from bridge.aero.stage import _unit_polygon
-from bridge.aero.static import shedding_frequency, static_coefficients, window_mean
+from bridge.aero.static import (
+    chordwise_loading,
+    shedding_frequency,
+    static_coefficients,
+    thin_plate_loading,
+    window_mean,
+)
 from bridge.cfd.sections import FlatPlate
 from bridge.errors import InputError
 
@@ -133,3 +139,40 @@ def test_the_static_group_report_and_lateral_model(tmp_path):
         "moment_slope_per_rad": 1.0}})
     model = own.aerodynamic_model(cfd=cfd)
     assert model.base is cfd.base and model.lateral.drag_coefficient == 0.3
+
+
+def test_the_thin_plates_loading_integrates_to_thin_aerofoil_theory():
+    """Delta C_p = 4 alpha sqrt((1 - x) / x) (Katz and Plotkin, Low-Speed Aerodynamics, 2001, 5.3): its strips
+    add up to 2 pi alpha, and samples of it give pi alpha / 2 about the mid-chord (the quarter-chord centre)."""
+    alpha = math.radians(3.0)
+    edges = (0.0, 0.05, 0.1, 0.2, 0.3, 0.5, 0.7, 0.9, 1.0)
+    strips = [thin_plate_loading(alpha, a, b) for a, b in zip(edges[:-1], edges[1:], strict=True)]
+    assert sum(strips) == pytest.approx(2 * math.pi * alpha, rel=1e-12)
+    assert strips[0] / sum(strips) == pytest.approx(0.282, abs=1e-3)      # the leading edge's share (module doc)
+    # midpoint samples in x = (1 - cos th) / 2, where the loading is smooth: dx = sin(th) / 2 dth
+    n = 4000
+    th = (np.arange(n) + 0.5) * math.pi / n
+    x = 0.5 * (1 - np.cos(th))
+    width = 0.5 * np.sin(th) * math.pi / n
+    got = chordwise_loading(x, 4 * alpha * np.sqrt((1 - x) / x), width, alpha, edges)
+    assert got.lift == pytest.approx(2 * math.pi * alpha, rel=1e-5)
+    assert got.moment == pytest.approx(math.pi * alpha / 2, rel=1e-5)
+    assert got.centre_of_pressure == pytest.approx(0.25, abs=1e-5)
+    one_sample = np.max(4 * alpha * np.sqrt((1 - x) / x) * width)   # a sample near a strip's edge counts on one side
+    assert got.strips == pytest.approx(got.potential, abs=one_sample)
+    # a uniform loading of 1: each strip its width, the centre of pressure at the mid-chord
+    x = (np.arange(100) + 0.5) / 100
+    flat = chordwise_loading(x, np.ones(100), np.full(100, 0.01), alpha, edges)
+    assert flat.strips == pytest.approx(np.diff(edges))
+    assert flat.centre_of_pressure == pytest.approx(0.5)
+    with pytest.raises(ValueError, match="edges"):
+        chordwise_loading(x, np.ones(100), np.full(100, 0.01), alpha, (0.1, 1.0))
+    with pytest.raises(ValueError, match="strip"):
+        thin_plate_loading(alpha, 0.5, 1.2)
+
+
+def test_run_case_shows_the_flow_to_an_observer_after_every_step():
+    q = dataclasses.replace(QUALITY["tiny"], static_duration=1.0)
+    seen = []
+    rec = run_case(_unit_polygon(FlatPlate(1.0, 0.1)), StaticCase(2.0), q, observe=lambda flow: seen.append(flow.t))
+    assert len(seen) == rec.steps and seen == pytest.approx(list(rec.t))

@@ -155,3 +155,76 @@ def test_the_static_case_holds_the_plate_at_its_angle_and_averages_the_coefficie
     assert c["C_L"]["std"] < 1e-6
     with pytest.raises(SystemExit):
         of.static_coefficients(angle, forces, 21.0)
+
+
+def _write_foam(path, cls, body: bytes, binary: bool):
+    path.parent.mkdir(parents=True, exist_ok=True)
+    head = (f"FoamFile\n{{\n    version 2.0;\n    format {'binary' if binary else 'ascii'};\n    class {cls};\n"
+            f'    arch "LSB;label=32;scalar=64";\n    object {path.name};\n}}\n').encode()
+    path.write_bytes(head + body)
+
+
+def _foam_list(values: np.ndarray, binary: bool) -> bytes:
+    n = values.shape[0]
+    if binary:
+        return f"{n}\n(".encode() + np.ascontiguousarray(values).tobytes() + b")\n"
+    rows = [("(" + " ".join(repr(float(v)) for v in row) + ")") if values.ndim > 1 else str(row) for row in values]
+    return f"{n}\n(\n".encode() + "\n".join(rows).encode() + b"\n)\n"
+
+
+@pytest.mark.parametrize("binary", [True, False])
+def test_the_plates_surface_pressure_is_read_from_the_case_as_openfoam_writes_it(tmp_path, binary):
+    """A plate patch of 4 upper, 4 lower and 2 edge faces (quads spanning z), each face's cell holding a known
+    pressure: the reader returns each side's faces along the chord with C_p = p / (1/2) (OpenFOAM's p per density,
+    V = 1), in binary (as the tool's cases are written) and in ascii (foamFormatConvert's faceList)."""
+    of = load_tool("openfoam_plate")
+    xs = np.array([-0.5, -0.3, 0.0, 0.2, 0.5])        # uneven faces along the chord
+    y = 0.01
+    pts = []
+    for yy in (y, -y):
+        for x in xs:
+            pts += [[x, yy, 0.0], [x, yy, 1.0]]
+    pts = np.array(pts)
+    n_side = xs.size
+
+    def quad(side, k):          # face between chord stations k and k + 1 on one side
+        a = 2 * (side * n_side + k)
+        return [a, a + 2, a + 3, a + 1]
+
+    faces = [quad(0, k) for k in range(4)] + [quad(1, k) for k in range(4)]
+    faces += [[0, 1, 2 * n_side + 1, 2 * n_side], [2 * n_side - 2, 2 * n_side - 1, 4 * n_side - 1, 4 * n_side - 2]]
+    first = 3                   # the plate's faces after three others (a degenerate, never read, internal face each)
+    faces = [[0, 1, 2, 3]] * first + faces
+    owner = np.array([0] * first + list(range(10)), dtype="<i4")
+    p = np.array([-0.30, -0.20, -0.10, -0.05, 0.10, 0.08, 0.06, 0.04, 0.5, -0.01])
+    case = tmp_path / "case"
+    mesh = case / "constant" / "polyMesh"
+    _write_foam(mesh / "points", "vectorField", _foam_list(pts.astype("<f8"), binary), binary)
+    if binary:
+        offsets = np.arange(len(faces) + 1, dtype="<i4") * 4
+        _write_foam(mesh / "faces", "faceCompactList", _foam_list(offsets, True)
+                    + _foam_list(np.array(faces, dtype="<i4").ravel(), True), True)
+    else:
+        body = f"{len(faces)}\n(\n".encode() + "\n".join("4(" + " ".join(map(str, f)) + ")" for f in faces).encode()
+        _write_foam(mesh / "faces", "faceList", body + b"\n)\n", False)
+    _write_foam(mesh / "owner", "labelList", _foam_list(owner, binary), binary)
+    patches = [("inlet", "patch", 3, 0), ("plate", "wall", 10, first)]
+    entries = "".join(f"    {n}\n    {{\n        type {k};\n        nFaces {m};\n        startFace {s};\n    }}\n"
+                      for n, k, m, s in patches)
+    (mesh / "boundary").write_text(f"FoamFile\n{{\n    format ascii;\n}}\n2\n(\n{entries})\n")
+    for t, scale in (("5", 0.5), ("20", 1.0)):       # the latest time is read unless another is asked for
+        _write_foam(case / t / "p", "volScalarField",
+                    b"dimensions [0 2 -2 0 0 0 0];\ninternalField nonuniform List<scalar> "
+                    + _foam_list((scale * p).astype("<f8"), binary) + b"boundaryField\n{\n}\n", binary)
+    got = of.plate_surface_pressure(case)
+    assert got["time"] == 20.0
+    assert got["upper"]["x"] == pytest.approx([0.1, 0.35, 0.6, 0.85])
+    assert got["upper"]["width"] == pytest.approx([0.2, 0.3, 0.2, 0.3])
+    assert got["upper"]["cp"] == pytest.approx(2 * p[:4])
+    assert got["lower"]["cp"] == pytest.approx(2 * p[4:8])
+    assert of.plate_surface_pressure(case, "5")["lower"]["cp"] == pytest.approx(p[4:8])
+    loading = of.plate_loading(case, 2.0)["loading"]
+    delta = 2 * (p[4:8] - p[:4])
+    assert loading.lift == pytest.approx(np.sum(delta * [0.2, 0.3, 0.2, 0.3]))
+    assert loading.moment == pytest.approx(-np.sum(delta * [0.2, 0.3, 0.2, 0.3] * (np.array([0.1, 0.35, 0.6, 0.85])
+                                                                                   - 0.5)))

@@ -1,0 +1,40 @@
+"""tools/plate_loading.py: our plate's pressure along the chord.  Bad input stops it before any run; a short
+coarse run reads the pressure on the plate's two sides (its lift carries most of the force record's, and the
+plate at -alpha loads the chord as at +alpha with the sign changed: the plate and its grid are mirror-symmetric)."""
+
+import json
+
+import numpy as np
+import pytest
+from cfd_helpers import load_tool
+
+
+@pytest.mark.parametrize("argv, option", [(["--angle", "0"], "--angle"), (["--duration", "0.5"], "--duration"),
+                                          (["--cells-per-chord", "4"], "--cells-per-chord"),
+                                          (["--openfoam", "no_such_case"], "--openfoam"),
+                                          (["--quality", "superb"], "superb")])
+def test_bad_input_exits_2_naming_the_option_and_writes_nothing(tmp_path, capsys, argv, option):
+    tool = load_tool("plate_loading")
+    out = tmp_path / "loading"
+    with pytest.raises(SystemExit) as e:
+        tool.main(argv + ["--out", str(out)])
+    assert e.value.code == 2
+    assert option in capsys.readouterr().err
+    assert not out.exists()
+
+
+@pytest.mark.slow
+def test_a_coarse_run_reads_the_pressure_on_both_sides_of_the_plate(tmp_path):
+    tool = load_tool("plate_loading")
+    got = {}
+    for angle in (2.0, -2.0):
+        out = tmp_path / f"a{angle:g}"
+        assert tool.main(["--quality", "quick", "--duration", "4", "--angle", str(angle), "--out", str(out)]) == 0
+        got[angle] = json.loads((out / "loading.json").read_text())
+        assert (out / "loading.png").stat().st_size > 1000
+    up, down = got[2.0], got[-2.0]
+    ratio = up["ours"]["lift_from_pressure"] / up["ours_force_record"]["C_L"]
+    assert 0.6 < ratio < 1.1, ratio          # 16 cells per chord: the samples lie 1.5-2.5 cells off the wall
+    assert up["ours"]["lift_from_pressure"] > 0
+    total = up["ours"]["lift_from_pressure"]
+    assert np.array(down["ours"]["strips"]) == pytest.approx(-np.array(up["ours"]["strips"]), abs=0.05 * total)
