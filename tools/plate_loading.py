@@ -1,7 +1,7 @@
 """Where the thin plate held at an angle carries its lift: the pressure along its chord (docs/aero.md).
 
     python tools/plate_loading.py [--angle 2] [--turbulence sst --reynolds 1e6] [--cells-per-chord 40]
-                                  [--quality standard] [--duration 20] [--openfoam CASE] [--out out/plate_loading]
+                                  [--dy-over-dx 0.25] [--quality standard] [--duration 20] [--openfoam CASE] [--out out/plate_loading]
 
 Why: our SST plate's moment per angle is 18-24 % below OpenFOAM's body-fitted plate's while the lifts agree
 within a few per cent (docs/aero.md), so the two codes carry the lift at different places along the chord.
@@ -147,6 +147,8 @@ def main(argv=None) -> int:
     ap.add_argument("--reynolds", type=float, default=1e6, help="V B / nu (default 1e6)")
     ap.add_argument("--quality", default="standard", help="aero preset, on its overset pair (default standard)")
     ap.add_argument("--cells-per-chord", type=int, default=None, help="the body grid's (default: the preset's)")
+    ap.add_argument("--dy-over-dx", type=float, default=None,
+                    help="the body grid's cell height over its width (default: the preset's)")
     ap.add_argument("--duration", type=float, default=20.0, help="B/V held (default 20); the last quarter averaged")
     ap.add_argument("--thickness", type=float, default=0.02, help="of the chord (default 0.02)")
     ap.add_argument("--threads", type=int, default=None, help="threads of the step (default: by grid size)")
@@ -167,7 +169,7 @@ def main(argv=None) -> int:
         ap.error(f"--openfoam: {args.openfoam} is no OpenFOAM case (no constant/polyMesh/boundary)")
     try:
         q = plate_quality(args.quality, "overset", args.turbulence, args.reynolds,
-                          {"cells_per_chord": args.cells_per_chord})
+                          {"cells_per_chord": args.cells_per_chord, "dy_over_dx": args.dy_over_dx})
         q = replace(q, static_duration=args.duration)
         check_output_root(args.out)
     except (InputError, KeyError, ValueError) as err:
@@ -176,6 +178,7 @@ def main(argv=None) -> int:
     loading = ours["loading"]
     result = {"angle_deg": args.angle, "turbulence": args.turbulence, "reynolds": args.reynolds,
               "thickness": args.thickness, "quality": args.quality, "cells_per_chord": q.cells_per_chord,
+              "dy_over_dx": q.dy_over_dx,
               "duration": args.duration, "cells": ours["cells"], "grids": ours["grids"], "wall_s": ours["wall_s"],
               "sample_height_cells": ours["sample_height_cells"], "ours": loading.as_dict(),
               "ours_force_record": ours["record"], "ours_delta_cp": {"x": ours["x"].tolist(),

@@ -11,6 +11,7 @@ from cfd_helpers import load_tool
 
 @pytest.mark.parametrize("argv, option", [(["--angle", "0"], "--angle"), (["--duration", "0.5"], "--duration"),
                                           (["--cells-per-chord", "4"], "--cells-per-chord"),
+                                          (["--dy-over-dx", "5"], "dy_over_dx"),
                                           (["--openfoam", "no_such_case"], "--openfoam"),
                                           (["--quality", "superb"], "superb")])
 def test_bad_input_exits_2_naming_the_option_and_writes_nothing(tmp_path, capsys, argv, option):
