@@ -23,8 +23,8 @@ surface about its mid-chord and deforms the mesh around it (``displacementLaplac
 ``angularOscillatingDisplacement`` on the plate), so that the inflow, outflow and sides stay where they are.
 ``--dof static`` turns the plate to ``--angle`` the same way (over the first B/V) and holds it there: the steady
 C_D, C_L, C_M (averaged over the last quarter of ``--duration``) beside the thin plate's potential flow, a
-reference for ``bridge.aero.static``, and the pressure along the chord at the end (:func:`plate_loading`;
-``tools/plate_loading.py --openfoam CASE`` puts it beside ours).
+reference for ``bridge.aero.static``, and the pressure along the chord, averaged over the same quarter
+(:func:`plate_loading`; ``tools/plate_loading.py --openfoam CASE`` puts it beside ours).
 
 Needs OpenFOAM (ESI v1912 was used: Debian's package ``openfoam``, ``apt-get install openfoam``); not a
 dependency of the project.  Writes the case to ``--out`` (default out/openfoam_plate/<case>), runs
@@ -174,6 +174,16 @@ def write_case(case: Path, dof: str, K: float, amplitude: float, reynolds: float
         (case / sub).mkdir(parents=True, exist_ok=True)
     mesh, cells = block_mesh_dict(edge, thickness, growth)
     (case / "system" / "blockMeshDict").write_text(mesh)
+    # held still: the pressure averaged over the last quarter too (pMean, read by plate_surface_pressure)
+    average = "" if dof != "static" else f"""
+    pAverage
+    {{
+        type fieldAverage;
+        libs ("libfieldFunctionObjects.so");
+        timeStart {0.75 * end_time:.12g};
+        writeControl writeTime;
+        fields (p {{ mean on; prime2Mean off; base time; }});
+    }}"""
     (case / "system" / "controlDict").write_text(HEADER.format(cls="dictionary", obj="controlDict") + f"""
 application pimpleFoam;
 startFrom latestTime;
@@ -205,7 +215,7 @@ functions
         writeControl timeStep;
         writeInterval 1;
         log false;
-    }}
+    }}{average}
 }}
 """)
     (case / "system" / "fvSchemes").write_text(HEADER.format(cls="dictionary", obj="fvSchemes") + """
@@ -548,7 +558,9 @@ def plate_surface_pressure(case: Path, time: str | None = None) -> dict:
     The plate turns as a rigid body, so its faces keep their places in the mesh as written at the start
     (constant/polyMesh), which is the plate's own frame: x from the leading edge in chords, the upper side at
     y > 0.  The wall takes its cell's pressure (zeroGradient; OpenFOAM's p is per density, the reference that of
-    the outflow).  Returns ``x``, ``width`` (the face's extent along the chord) and ``cp`` for each side."""
+    the outflow): the time average ``pMean`` where the folder holds one (a static case's last quarter), else the
+    pressure of that instant.  Returns ``x``, ``width`` (the face's extent along the chord) and ``cp`` for each
+    side, and which ``field`` was read."""
     case = Path(case)
     times = sorted((d for d in case.iterdir() if d.is_dir() and re.fullmatch(r"[0-9.eE+-]+", d.name)
                     and (d / "p").is_file()), key=lambda d: float(d.name))
@@ -570,7 +582,8 @@ def plate_surface_pressure(case: Path, time: str | None = None) -> dict:
         raise SystemExit(f"{mesh / 'boundary'}: no patch 'plate'")
     n = int(re.search(r"nFaces\s+(\d+)", entry.group(1)).group(1))
     first = int(re.search(r"startFace\s+(\d+)", entry.group(1)).group(1))
-    pb, binary = _foam_body(folder / "p")
+    field = "pMean" if (folder / "pMean").is_file() else "p"     # the time average where the case wrote one
+    pb, binary = _foam_body(folder / field)
     p, _ = _foam_list(pb, binary, "<f8", start=pb.index(b"internalField"))
     faces = [labels[offsets[f]:offsets[f + 1]] for f in range(first, first + n)]
     xs = [points[f, 0] for f in faces]
@@ -578,7 +591,7 @@ def plate_surface_pressure(case: Path, time: str | None = None) -> dict:
     width = np.array([x.max() - x.min() for x in xs])
     cp = p[owner[first:first + n]] / 0.5
     flat = width > 1e-9                   # the upper and lower faces; the edges' faces have no extent along x
-    out = {"time": float(folder.name)}
+    out = {"time": float(folder.name), "field": field}
     for side, sel in (("upper", flat & (centre[:, 1] > 0)), ("lower", flat & (centre[:, 1] < 0))):
         order = np.argsort(centre[sel, 0])
         out[side] = {"x": centre[sel, 0][order] + 0.5, "width": width[sel][order], "cp": cp[sel][order]}
@@ -594,7 +607,7 @@ def plate_loading(case: Path, angle_deg: float, time: str | None = None) -> dict
     s = plate_surface_pressure(case, time)
     up, lo = s["upper"], s["lower"]
     delta = lo["cp"] - np.interp(lo["x"], up["x"], up["cp"])
-    return {"x": lo["x"], "delta_cp": delta, "time": s["time"],
+    return {"x": lo["x"], "delta_cp": delta, "time": s["time"], "field": s["field"],
             "loading": chordwise_loading(lo["x"], delta, lo["width"], math.radians(angle_deg))}
 
 
@@ -708,15 +721,17 @@ def _static(args, name: str) -> int:
     result = {"case": name, **_common(args, cells, forces, wall), "angle_deg": args.angle,
               "duration": args.duration, **coefficients}
     if args.angle:   # where along the chord the plate carries its lift (tools/plate_loading.py compares ours)
-        loading = plate_loading(case, args.angle)["loading"]
-        result["loading"] = loading.as_dict()
+        got = plate_loading(case, args.angle)
+        loading = got["loading"]
+        result["loading"] = {**loading.as_dict(), "pressure_field": got["field"]}
     (case / "result.json").write_text(json.dumps(result, indent=1))
     print(f"{cells} cells, {forces['t'].size} steps, {wall:.0f} s; averaged over t >= {0.75 * args.duration:g}")
     for n, c in coefficients.items():
         ref = (f", {c['ratio']:.3f} x potential flow's {c['potential_flow']:+.4f}" if "ratio" in c else "")
         print(f"  {n}: {c['mean']:+.4f} (sd {c['std']:.1e}){ref}")
     if "loading" in result:
-        print(f"  from the plate's pressure at t = {args.duration:g}: C_L {loading.lift:+.4f}, "
+        print(f"  from the plate's pressure ({'averaged' if got['field'] == 'pMean' else 'at the end'}): "
+              f"C_L {loading.lift:+.4f}, "
               f"C_M {loading.moment:+.4f}, centre of pressure {loading.centre_of_pressure:.3f} chords from the "
               "leading edge")
     return 0

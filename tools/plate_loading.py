@@ -1,7 +1,8 @@
 """Where the thin plate held at an angle carries its lift: the pressure along its chord (docs/aero.md).
 
     python tools/plate_loading.py [--angle 2] [--turbulence sst --reynolds 1e6] [--cells-per-chord 40]
-                                  [--dy-over-dx 0.25] [--quality standard] [--duration 20] [--openfoam CASE] [--out out/plate_loading]
+                                  [--dy-over-dx 0.25] [--quality standard] [--duration 20]
+                                  [--openfoam CASE] [--out out/plate_loading]
 
 Why: our SST plate's moment per angle is 18-24 % below OpenFOAM's body-fitted plate's while the lifts agree
 within a few per cent (docs/aero.md), so the two codes carry the lift at different places along the chord.
@@ -13,7 +14,8 @@ with the plate, so its rows are parallel to the chord.  Delta C_p is summed over
 the thin plate's potential flow (``bridge.aero.static.chordwise_loading``), with C_L, C_M (mid-chord, nose-up)
 and the centre of pressure from these samples beside the force record's (what the samples miss: the wall
 lies 1.5-2.5 cells below them, and the leading edge's peak is steep).  ``--openfoam CASE`` adds the same for a
-case of ``python tools/openfoam_plate.py --dof static`` (the pressure of the cells on the plate's faces).
+case of ``python tools/openfoam_plate.py --dof static`` (the pressure of the cells on the plate's faces, averaged
+over the last quarter where the case wrote pMean, else at its last time).
 
 Writes ``loading.json`` and ``loading.png`` (Delta C_p along the chord) to ``--out``.
 """
@@ -191,8 +193,10 @@ def main(argv=None) -> int:
 
         got = plate_loading(args.openfoam, args.angle)
         of = got["loading"]
-        result["openfoam"] = {"case": str(args.openfoam), "time": got["time"], **of.as_dict()}
-        print(_row(f"OpenFOAM ({args.openfoam.name}, t = {got['time']:g})", of))
+        result["openfoam"] = {"case": str(args.openfoam), "time": got["time"], "pressure_field": got["field"],
+                              **of.as_dict()}
+        when = "time-averaged" if got["field"] == "pMean" else f"t = {got['time']:g}"
+        print(_row(f"OpenFOAM ({args.openfoam.name}, {when})", of))
         curves.append(("OpenFOAM, " + args.openfoam.name, got["x"], got["delta_cp"]))
         rows.append(("OpenFOAM", of))
     print("strip of the chord   " + "   ".join(f"{n:>9}" for n, _ in rows) + "   potential flow")

@@ -136,6 +136,8 @@ def test_the_static_case_holds_the_plate_at_its_angle_and_averages_the_coefficie
     text = (tmp_path / "s" / "0" / "pointDisplacement").read_text()
     assert "solidBodyMotionDisplacement" in text and "tabulated6DoFMotion" in text and "CofG (0 0 0);" in text
     assert "displacementLaplacian" in (tmp_path / "s" / "constant" / "dynamicMeshDict").read_text()
+    control = (tmp_path / "s" / "system" / "controlDict").read_text()
+    assert "fieldAverage" in control and "timeStart 15;" in control     # the pressure over the last quarter
     rows = (tmp_path / "s" / "constant" / "rotation.dat").read_text().splitlines()
     assert int(rows[0]) == len(rows) - 3 and rows[1] == "(" and rows[-1] == ")"
     table = np.array([of._numbers(r) for r in rows[2:-1]])        # t, translation, rotation (degrees)
@@ -223,8 +225,15 @@ def test_the_plates_surface_pressure_is_read_from_the_case_as_openfoam_writes_it
     assert got["upper"]["cp"] == pytest.approx(2 * p[:4])
     assert got["lower"]["cp"] == pytest.approx(2 * p[4:8])
     assert of.plate_surface_pressure(case, "5")["lower"]["cp"] == pytest.approx(p[4:8])
+    assert got["field"] == "p"
     loading = of.plate_loading(case, 2.0)["loading"]
     delta = 2 * (p[4:8] - p[:4])
     assert loading.lift == pytest.approx(np.sum(delta * [0.2, 0.3, 0.2, 0.3]))
     assert loading.moment == pytest.approx(-np.sum(delta * [0.2, 0.3, 0.2, 0.3] * (np.array([0.1, 0.35, 0.6, 0.85])
                                                                                    - 0.5)))
+    # a time average written beside the instant's pressure is read instead
+    _write_foam(case / "20" / "pMean", "volScalarField",
+                b"dimensions [0 2 -2 0 0 0 0];\ninternalField nonuniform List<scalar> "
+                + _foam_list((3.0 * p).astype("<f8"), binary) + b"boundaryField\n{\n}\n", binary)
+    averaged = of.plate_surface_pressure(case)
+    assert averaged["field"] == "pMean" and averaged["upper"]["cp"] == pytest.approx(6 * p[:4])
