@@ -39,3 +39,13 @@ def test_a_coarse_run_reads_the_pressure_on_both_sides_of_the_plate(tmp_path):
     assert up["ours"]["lift_from_pressure"] > 0
     total = up["ours"]["lift_from_pressure"]
     assert np.array(down["ours"]["strips"]) == pytest.approx(-np.array(up["ours"]["strips"]), abs=0.05 * total)
+
+
+def test_the_samples_are_the_first_cells_off_the_plate_that_no_forcing_touches():
+    tool = load_tool("plate_loading")
+    y = (np.arange(10) - 4.5) * 0.1           # cell centres, the plate about y = 0
+    forced = np.zeros((10, 3), dtype=bool)
+    forced[3:7, :] = True                     # the plate and its forced neighbours
+    forced[7, 1] = True                       # a column where the forcing reaches one cell further up
+    up, down = tool.surface_rows(forced, y, np.array([0, 1, 2]))
+    assert up.tolist() == [7, 8, 7] and down.tolist() == [2, 2, 2]
