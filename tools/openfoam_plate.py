@@ -509,12 +509,13 @@ def derivatives(dof: str, K: float, amplitude: float, forces: dict, discard: int
 # ---------------------------------------------------------------------------------------------- the plate's pressure
 
 
-def _foam_body(path: Path) -> tuple[bytes, bool]:
-    """The bytes of an OpenFOAM file after its FoamFile header, and whether it is written in binary."""
+def _foam_body(path: Path) -> tuple[bytes, bool, bytes]:
+    """The bytes of an OpenFOAM file after its FoamFile header, whether it is written in binary, and its class."""
     raw = path.read_bytes()
     head = raw.index(b"FoamFile")
     end = raw.index(b"}", head)
-    return raw[end + 1:], re.search(rb"format\s+binary", raw[head:end]) is not None
+    cls = re.search(rb"class\s+(\w+)", raw[head:end])
+    return raw[end + 1:], re.search(rb"format\s+binary", raw[head:end]) is not None, cls.group(1) if cls else b""
 
 
 def _foam_list(data: bytes, binary: bool, dtype, width: int = 1, start: int = 0) -> tuple[np.ndarray, int]:
@@ -540,8 +541,8 @@ def _foam_list(data: bytes, binary: bool, dtype, width: int = 1, start: int = 0)
 def _foam_faces(path: Path) -> tuple[np.ndarray, np.ndarray]:
     """A mesh's faces as (offsets, point labels): a faceCompactList (binary, as this tool's cases write it) or
     an ascii faceList (``N ( 4(a b c d) ... )``, as foamFormatConvert to ascii writes it)."""
-    data, binary = _foam_body(path)
-    if binary or b"faceCompactList" in path.read_bytes()[:2000]:
+    data, binary, cls = _foam_body(path)
+    if binary or cls == b"faceCompactList":
         offsets, end = _foam_list(data, binary, "<i4")
         labels, _ = _foam_list(data, binary, "<i4", start=end)
         return offsets, labels
@@ -571,10 +572,10 @@ def plate_surface_pressure(case: Path, time: str | None = None) -> dict:
     else:
         folder = case / time
     mesh = case / "constant" / "polyMesh"
-    pts, binary = _foam_body(mesh / "points")
+    pts, binary, _ = _foam_body(mesh / "points")
     points, _ = _foam_list(pts, binary, "<f8", 3)
     offsets, labels = _foam_faces(mesh / "faces")
-    ob, binary = _foam_body(mesh / "owner")
+    ob, binary, _ = _foam_body(mesh / "owner")
     owner, _ = _foam_list(ob, binary, "<i4")
     boundary = (mesh / "boundary").read_text()
     entry = re.search(r"\bplate\s*\{([^}]*)\}", boundary)
@@ -583,7 +584,7 @@ def plate_surface_pressure(case: Path, time: str | None = None) -> dict:
     n = int(re.search(r"nFaces\s+(\d+)", entry.group(1)).group(1))
     first = int(re.search(r"startFace\s+(\d+)", entry.group(1)).group(1))
     field = "pMean" if (folder / "pMean").is_file() else "p"     # the time average where the case wrote one
-    pb, binary = _foam_body(folder / field)
+    pb, binary, _ = _foam_body(folder / field)
     p, _ = _foam_list(pb, binary, "<f8", start=pb.index(b"internalField"))
     faces = [labels[offsets[f]:offsets[f + 1]] for f in range(first, first + n)]
     xs = [points[f, 0] for f in faces]
