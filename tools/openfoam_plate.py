@@ -562,41 +562,78 @@ def plate_surface_pressure(case: Path, time: str | None = None) -> dict:
     the outflow): the time average ``pMean`` where the folder holds one (a static case's last quarter), else the
     pressure of that instant.  Returns ``x``, ``width`` (the face's extent along the chord) and ``cp`` for each
     side, and which ``field`` was read."""
+    folder = _time_folder(case, time)
+    mesh = _PlateMesh(case)
+    field = "pMean" if (folder / "pMean").is_file() else "p"     # the time average where the case wrote one
+    cp = _foam_field(folder / field)[mesh.owner[mesh.plate]] / 0.5
+    out = {"time": float(folder.name), "field": field}
+    for side, sel in mesh.sides():
+        out[side] = {"x": mesh.centre[sel, 0] + 0.5, "width": mesh.width[sel], "cp": cp[sel]}
+    return out
+
+
+def _time_folder(case: Path, time: str | None) -> Path:
+    """The case's folder of ``time``, by default the latest that holds a pressure field."""
     case = Path(case)
+    if time is not None:
+        return case / time
     times = sorted((d for d in case.iterdir() if d.is_dir() and re.fullmatch(r"[0-9.eE+-]+", d.name)
                     and (d / "p").is_file()), key=lambda d: float(d.name))
-    if time is None:
-        if not times:
-            raise SystemExit(f"{case}: no time folder with a pressure field")
-        folder = times[-1]
-    else:
-        folder = case / time
-    mesh = case / "constant" / "polyMesh"
-    pts, binary, _ = _foam_body(mesh / "points")
-    points, _ = _foam_list(pts, binary, "<f8", 3)
-    offsets, labels = _foam_faces(mesh / "faces")
-    ob, binary, _ = _foam_body(mesh / "owner")
-    owner, _ = _foam_list(ob, binary, "<i4")
-    boundary = (mesh / "boundary").read_text()
-    entry = re.search(r"\bplate\s*\{([^}]*)\}", boundary)
-    if entry is None:
-        raise SystemExit(f"{mesh / 'boundary'}: no patch 'plate'")
-    n = int(re.search(r"nFaces\s+(\d+)", entry.group(1)).group(1))
-    first = int(re.search(r"startFace\s+(\d+)", entry.group(1)).group(1))
-    field = "pMean" if (folder / "pMean").is_file() else "p"     # the time average where the case wrote one
-    pb, binary, _ = _foam_body(folder / field)
-    p, _ = _foam_list(pb, binary, "<f8", start=pb.index(b"internalField"))
-    faces = [labels[offsets[f]:offsets[f + 1]] for f in range(first, first + n)]
-    xs = [points[f, 0] for f in faces]
-    centre = np.array([points[f].mean(axis=0) for f in faces])
-    width = np.array([x.max() - x.min() for x in xs])
-    cp = p[owner[first:first + n]] / 0.5
-    flat = width > 1e-9                   # the upper and lower faces; the edges' faces have no extent along x
-    out = {"time": float(folder.name), "field": field}
-    for side, sel in (("upper", flat & (centre[:, 1] > 0)), ("lower", flat & (centre[:, 1] < 0))):
-        order = np.argsort(centre[sel, 0])
-        out[side] = {"x": centre[sel, 0][order] + 0.5, "width": width[sel][order], "cp": cp[sel][order]}
-    return out
+    if not times:
+        raise SystemExit(f"{case}: no time folder with a pressure field")
+    return times[-1]
+
+
+def _foam_field(path: Path, width: int = 1) -> np.ndarray:
+    """A volume field's values in the cells (its internalField: a nonuniform list)."""
+    data, binary, _ = _foam_body(path)
+    return _foam_list(data, binary, "<f8", width, start=data.index(b"internalField"))[0]
+
+
+class _PlateMesh:
+    """The case's mesh as written at the start (constant/polyMesh): the points, the faces, their owner cells,
+    and the faces of the patch ``plate`` (``plate``: their indices; ``centre``, ``width``: along the chord)."""
+
+    def __init__(self, case: Path):
+        mesh = Path(case) / "constant" / "polyMesh"
+        pts, binary, _ = _foam_body(mesh / "points")
+        self.points, _ = _foam_list(pts, binary, "<f8", 3)
+        self.offsets, self.labels = _foam_faces(mesh / "faces")
+        ob, binary, _ = _foam_body(mesh / "owner")
+        self.owner, _ = _foam_list(ob, binary, "<i4")
+        self.mesh = mesh
+        entry = re.search(r"\bplate\s*\{([^}]*)\}", (mesh / "boundary").read_text())
+        if entry is None:
+            raise SystemExit(f"{mesh / 'boundary'}: no patch 'plate'")
+        n = int(re.search(r"nFaces\s+(\d+)", entry.group(1)).group(1))
+        first = int(re.search(r"startFace\s+(\d+)", entry.group(1)).group(1))
+        self.plate = np.arange(first, first + n)
+        faces = [self.labels[self.offsets[f]:self.offsets[f + 1]] for f in self.plate]
+        self.centre = np.array([self.points[f].mean(axis=0) for f in faces])
+        self.width = np.array([np.ptp(self.points[f, 0]) for f in faces])
+
+    def sides(self):
+        """("upper" | "lower", indices into ``plate``, ordered along the chord) for the two flat sides (the edges'
+        faces have no extent along x)."""
+        flat = self.width > 1e-9
+        for side, sel in (("upper", flat & (self.centre[:, 1] > 0)), ("lower", flat & (self.centre[:, 1] < 0))):
+            idx = np.nonzero(sel)[0]
+            yield side, idx[np.argsort(self.centre[idx, 0])]
+
+    def cell_centres(self) -> np.ndarray:
+        """Each cell's centre as the mean of its faces' centres (exact for the cells of this tool's blockMesh,
+        which are rectangles at the start)."""
+        nb, binary, _ = _foam_body(self.mesh / "neighbour")
+        neighbour, _ = _foam_list(nb, binary, "<i4")
+        counts = np.diff(self.offsets)
+        face_centres = np.add.reduceat(self.points[self.labels], self.offsets[:-1], axis=0) / counts[:, None]
+        n_cells = int(self.owner.max()) + 1
+        total, faces = np.zeros((n_cells, 3)), np.zeros(n_cells)
+        for cells, centres in ((self.owner, face_centres[:self.owner.size]),
+                               (neighbour, face_centres[:neighbour.size])):
+            np.add.at(total, cells, centres)
+            np.add.at(faces, cells, 1.0)
+        return total / faces[:, None]
 
 
 def plate_loading(case: Path, angle_deg: float, time: str | None = None) -> dict:
@@ -610,6 +647,32 @@ def plate_loading(case: Path, angle_deg: float, time: str | None = None) -> dict
     delta = lo["cp"] - np.interp(lo["x"], up["x"], up["cp"])
     return {"x": lo["x"], "delta_cp": delta, "time": s["time"], "field": s["field"],
             "loading": chordwise_loading(lo["x"], delta, lo["width"], math.radians(angle_deg))}
+
+
+def plate_eddy_viscosity(case: Path, angle_deg: float, nu: float, height: float = 0.05,
+                         time: str | None = None) -> dict:
+    """Along the plate's upper side at ``time`` (default: the latest written): the largest eddy viscosity over
+    nu in the cells within ``height`` (chords) above each face, and the velocity along the chord (leading to
+    trailing edge; the plate turned nose-up by ``angle_deg``) in the face's own cell, the first off the wall.
+    The cells are placed as written at the start (constant/polyMesh); the mesh deforms round the turning plate,
+    which moves cells this close to it as the plate (0.2 % of their distance from the mid-chord at 2 degrees).
+    Returns ``x`` (from the leading edge), ``nut_over_nu_max``, ``first_cell_height`` and ``first_cell_u``."""
+    folder = _time_folder(case, time)
+    mesh = _PlateMesh(case)
+    centres = mesh.cell_centres()
+    nut = _foam_field(folder / "nut")
+    velocity = _foam_field(folder / "U", 3)
+    a = math.radians(angle_deg)
+    along = velocity[:, 0] * math.cos(a) - velocity[:, 1] * math.sin(a)
+    idx = dict(mesh.sides())["upper"]
+    peak = []
+    for x, w, top in zip(mesh.centre[idx, 0], mesh.width[idx], mesh.centre[idx, 1], strict=True):
+        above = centres[:, 1] - top
+        column = (np.abs(centres[:, 0] - x) < 0.25 * w) & (above > 0) & (above < height)
+        peak.append(float(nut[column].max()) / nu if column.any() else float("nan"))
+    first = mesh.owner[mesh.plate[idx]]
+    return {"time": float(folder.name), "x": mesh.centre[idx, 0] + 0.5, "nut_over_nu_max": np.array(peak),
+            "first_cell_height": centres[first, 1] - mesh.centre[idx, 1], "first_cell_u": along[first]}
 
 
 def static_coefficients(angle: float, forces: dict, average_from: float) -> dict:

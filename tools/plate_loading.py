@@ -2,7 +2,7 @@
 
     python tools/plate_loading.py [--angle 2] [--turbulence sst --reynolds 1e6] [--cells-per-chord 40]
                                   [--dy-over-dx 0.25] [--quality standard] [--duration 20]
-                                  [--openfoam CASE] [--out out/plate_loading]
+                                  [--body-walls function|resolved] [--openfoam CASE] [--out out/plate_loading]
 
 Why: our SST plate's moment per angle is 18-24 % below OpenFOAM's body-fitted plate's while the lifts agree
 within a few per cent (docs/aero.md), so the two codes carry the lift at different places along the chord.
@@ -17,7 +17,14 @@ lies 1.5-2.5 cells below them, and the leading edge's peak is steep).  ``--openf
 case of ``python tools/openfoam_plate.py --dof static`` (the pressure of the cells on the plate's faces, averaged
 over the last quarter where the case wrote pMean, else at its last time).
 
-Writes ``loading.json`` and ``loading.png`` (Delta C_p along the chord) to ``--out``.
+Above the upper side it also gives, along the chord, the largest eddy viscosity (nu_t / nu) within 0.05 chord
+of the surface and the velocity along the chord in the first cell off the wall (ours: the first no forcing
+touches; OpenFOAM's: the face's own cell), time-averaged as the pressure (OpenFOAM's: at its last time): where a
+code's boundary layer is laminar, turbulent or reversed.  ``--body-walls resolved`` runs our SST with the
+plate's walls resolved instead of Spalding's wall function (a diagnostic: at Re 1e6 the first cells lie far
+above the viscous sublayer, so the wall shear is not right either; docs/aero.md).
+
+Writes ``loading.json`` and ``loading.png`` (Delta C_p and the eddy viscosity along the chord) to ``--out``.
 """
 
 from __future__ import annotations
@@ -47,8 +54,11 @@ def _say(message: str) -> None:
     print(message, file=sys.stderr, flush=True)
 
 
-class _PressureAverage:
-    """The body grid's pressure averaged in time from ``start`` on (``run_case``'s ``observe``)."""
+class _FieldAverage:
+    """The body grid's pressure, nu + nu_t and velocity (storage arrays) averaged in time from ``start`` on
+    (``run_case``'s ``observe``)."""
+
+    FIELDS = ("p", "nu", "u")
 
     def __init__(self, start: float):
         self.start, self.sum, self.span, self.flow, self._t = start, None, 0.0, None, None
@@ -58,14 +68,14 @@ class _PressureAverage:
         if t_old is None or flow.t <= self.start:
             return
         dt = flow.t - t_old
-        p = flow.body.p.numpy()
-        self.sum = dt * p if self.sum is None else self.sum + dt * p
+        now = [dt * getattr(flow.body, name).numpy() for name in self.FIELDS]
+        self.sum = now if self.sum is None else [a + b for a, b in zip(self.sum, now, strict=True)]
         self.span += dt
 
-    def mean(self) -> np.ndarray:
+    def mean(self, name: str) -> np.ndarray:
         if self.sum is None:
             raise RuntimeError("no steps after the start of the average")
-        return self.sum / self.span
+        return self.sum[self.FIELDS.index(name)] / self.span
 
 
 def surface_rows(forced: np.ndarray, y_centres: np.ndarray, columns: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -79,29 +89,47 @@ def surface_rows(forced: np.ndarray, y_centres: np.ndarray, columns: np.ndarray)
     return np.array(up), np.array(down)
 
 
-def our_loading(angle_deg: float, quality, thickness: float, threads: int | None) -> dict:
-    """The plate held at ``angle_deg`` on ``quality`` (an overset preset); the loading and the force record's
-    coefficients over the last quarter."""
+def our_loading(angle_deg: float, quality, thickness: float, threads: int | None,
+                body_walls: str = "function") -> dict:
+    """The plate held at ``angle_deg`` on ``quality`` (an overset preset); the loading, the eddy viscosity above
+    the upper side (:func:`upper_side_flow`) and the force record's coefficients over the last quarter."""
     poly = _unit_polygon(FlatPlate(1.0, thickness))
-    average = _PressureAverage(0.75 * quality.static_duration)
+    average = _FieldAverage(0.75 * quality.static_duration)
     rec = run_case(poly, StaticCase(angle_deg), quality, progress=_say, label=f"plate at {angle_deg:g} deg",
-                   threads=threads, observe=average)
+                   threads=threads, observe=average, body_walls=body_walls)
     flow = average.flow
     grid = flow.body.grid
-    p = average.mean()[GHOST:GHOST + grid.ny, GHOST:GHOST + grid.nx]
+    inner = (slice(GHOST, GHOST + grid.ny), slice(GHOST, GHOST + grid.nx))
+    p = average.mean("p")[inner]
     forced = flow.body.bodies[0].forced_cells()
     columns = np.nonzero(np.abs(grid.x_centres) < 0.5)[0]
     up, down = surface_rows(forced, grid.y_centres, columns)
     delta = (p[down, columns] - p[up, columns]) / 0.5
     x = grid.x_centres[columns] + 0.5
+    u_faces = average.mean("u")[GHOST:GHOST + grid.ny, GHOST:GHOST + grid.nx + 1]
+    upper = upper_side_flow(average.mean("nu")[inner] * quality.reynolds - 1.0,
+                            0.5 * (u_faces[:, :-1] + u_faces[:, 1:]), grid.y_centres, columns, up, thickness / 2)
     loading = chordwise_loading(x, delta, np.full(x.size, grid.dx), math.radians(angle_deg))
     sel = rec.t > 0.75 * rec.t[-1]
     record = {"C_L": float(2 * rec.lift[sel].mean()), "C_M": float(2 * rec.moment[sel].mean()),
+              "C_D": float(2 * rec.drag[sel].mean()),
               "C_L_std": float(2 * rec.lift[sel].std())}
     record["centre_of_pressure"] = 0.5 - record["C_M"] / record["C_L"]
     return {"loading": loading, "record": record, "x": x, "delta_cp": delta,
             "sample_height_cells": float(np.mean(grid.y_centres[up] - thickness / 2) / grid.dy[0]),
+            "upper_side": {"x": x, **upper},
             "cells": rec.meta["cells"], "grids": rec.meta["grids"], "wall_s": rec.wall_s}
+
+
+def upper_side_flow(nut_over_nu: np.ndarray, u_centres: np.ndarray, y_centres: np.ndarray, columns: np.ndarray,
+                    rows: np.ndarray, top: float, height: float = 0.05) -> dict:
+    """Above the plate's upper side (its surface at y = ``top``; arrays (ny, nx) of cell values): in each of
+    ``columns`` the largest nu_t / nu of the cells whose centres lie within ``height`` above the surface, and the
+    velocity along the chord in the first cell that no forcing touches (``rows``, from :func:`surface_rows`)
+    with that cell's height above the surface."""
+    band = (y_centres > top) & (y_centres < top + height)
+    return {"nut_over_nu_max": nut_over_nu[np.ix_(band, columns)].max(axis=0),
+            "first_cell_height": y_centres[rows] - top, "first_cell_u": u_centres[rows, columns]}
 
 
 def _row(name: str, loading, record: dict | None = None) -> str:
@@ -115,7 +143,11 @@ def _row(name: str, loading, record: dict | None = None) -> str:
     return text
 
 
-def _plot(path: Path, curves: list[tuple[str, np.ndarray, np.ndarray]], alpha: float) -> None:
+def _listed(side: dict) -> dict:
+    return {k: np.asarray(v).tolist() for k, v in side.items() if k != "time"}
+
+
+def _plot(path: Path, curves: list[tuple[str, np.ndarray, np.ndarray]], alpha: float, sides: list) -> None:
     import io
 
     import matplotlib
@@ -123,16 +155,21 @@ def _plot(path: Path, curves: list[tuple[str, np.ndarray, np.ndarray]], alpha: f
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(7, 4))
+    fig, (ax, bx) = plt.subplots(2, 1, figsize=(7, 7), sharex=True)
     x = np.linspace(0.002, 0.998, 500)
     ax.plot(x, 4 * alpha * np.sqrt((1 - x) / x), "k-", lw=1, label="thin plate, potential flow")
     for name, xs, d in curves:
         ax.plot(xs, d, ".-", ms=3, lw=1, label=name)
-    ax.set_xlabel("x / B from the leading edge")
     ax.set_ylabel("Delta C_p (lower - upper)")
     ax.set_ylim(-0.2, 1.5)
     ax.grid(alpha=0.3)
     ax.legend()
+    for name, side in sides:
+        bx.semilogy(side["x"], np.maximum(side["nut_over_nu_max"], 1e-3), ".-", ms=3, lw=1, label=name)
+    bx.set_xlabel("x / B from the leading edge")
+    bx.set_ylabel("largest nu_t / nu within 0.05 B\nabove the upper side")
+    bx.grid(alpha=0.3)
+    bx.legend()
     fig.tight_layout()
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=120)
@@ -156,8 +193,13 @@ def main(argv=None) -> int:
     ap.add_argument("--threads", type=int, default=None, help="threads of the step (default: by grid size)")
     ap.add_argument("--openfoam", type=Path, default=None, metavar="CASE",
                     help="a case of tools/openfoam_plate.py --dof static at the same angle, shown beside ours")
+    ap.add_argument("--body-walls", choices=("function", "resolved"), default="function",
+                    help="with SST: the plate's walls by Spalding's wall function (default; the aero stage's) or as a "
+                         "resolved wall (a diagnostic: its first cells lie far above the viscous sublayer)")
     ap.add_argument("--out", type=Path, default=Path("out/plate_loading"), help="folder (default out/plate_loading)")
     args = ap.parse_args(argv)
+    if args.body_walls != "function" and args.turbulence != "sst":
+        ap.error(f"--body-walls: {args.body_walls} needs --turbulence sst (a laminar plate has resolved walls)")
     for name, value, ok, allowed in (
             ("--angle", args.angle, 0.0 < abs(args.angle) <= 10.0, "0 < |angle| <= 10 degrees"),
             ("--reynolds", args.reynolds, args.reynolds > 0, "> 0"),
@@ -176,22 +218,26 @@ def main(argv=None) -> int:
         check_output_root(args.out)
     except (InputError, KeyError, ValueError) as err:
         ap.error(str(err))
-    ours = our_loading(args.angle, q, args.thickness, args.threads)
+    ours = our_loading(args.angle, q, args.thickness, args.threads, args.body_walls)
     loading = ours["loading"]
     result = {"angle_deg": args.angle, "turbulence": args.turbulence, "reynolds": args.reynolds,
               "thickness": args.thickness, "quality": args.quality, "cells_per_chord": q.cells_per_chord,
-              "dy_over_dx": q.dy_over_dx,
+              "dy_over_dx": q.dy_over_dx, "body_walls": args.body_walls,
               "duration": args.duration, "cells": ours["cells"], "grids": ours["grids"], "wall_s": ours["wall_s"],
               "sample_height_cells": ours["sample_height_cells"], "ours": loading.as_dict(),
               "ours_force_record": ours["record"], "ours_delta_cp": {"x": ours["x"].tolist(),
-                                                                     "delta_cp": ours["delta_cp"].tolist()}}
+                                                                     "delta_cp": ours["delta_cp"].tolist()},
+              "ours_upper_side": _listed(ours["upper_side"])}
     print(_row(f"ours ({q.cells_per_chord} cells per chord)", loading, ours["record"]))
     curves = [(f"ours, {q.cells_per_chord} cells per chord", ours["x"], ours["delta_cp"])]
     rows = [("ours", loading)]
+    sides = [("ours", ours["upper_side"])]
     if args.openfoam is not None:
-        from openfoam_plate import plate_loading
+        from openfoam_plate import plate_eddy_viscosity, plate_loading
 
         got = plate_loading(args.openfoam, args.angle)
+        sides.append(("OpenFOAM", plate_eddy_viscosity(args.openfoam, args.angle, 1.0 / args.reynolds)))
+        result["openfoam_upper_side"] = _listed(sides[-1][1])
         of = got["loading"]
         result["openfoam"] = {"case": str(args.openfoam), "time": got["time"], "pressure_field": got["field"],
                               **of.as_dict()}
@@ -203,8 +249,16 @@ def main(argv=None) -> int:
     for k in range(loading.strips.size):
         cells = "   ".join(f"{r.strips[k]:9.5f}" for _, r in rows)
         print(f"  {loading.edges[k]:.2f} - {loading.edges[k + 1]:.2f}        {cells}   {loading.potential[k]:9.5f}")
+    print("above the upper side: largest nu_t/nu within 0.05 chord; u along the chord in the first free cell")
+    print("  x/B    " + "   ".join(f"{n:>17}" for n, _ in sides))
+    for x0 in (0.01, 0.02, 0.05, 0.1, 0.2, 0.4, 0.7, 0.9):
+        cells = []
+        for _, side in sides:
+            i = int(np.argmin(np.abs(side["x"] - x0)))
+            cells.append(f"{side['nut_over_nu_max'][i]:8.1f} {side['first_cell_u'][i]:+8.3f}")
+        print(f"  {x0:4.2f}   " + "   ".join(cells))
     atomic_write_text(args.out / "loading.json", json.dumps(result, indent=1))
-    _plot(args.out / "loading.png", curves, math.radians(args.angle))
+    _plot(args.out / "loading.png", curves, math.radians(args.angle), sides)
     print(f"wrote {args.out / 'loading.json'} and {args.out / 'loading.png'}")
     return 0
 

@@ -362,7 +362,7 @@ def _load_checkpoint(path: Path, key: str, flow) -> dict | None:
 def run_case(shape, case: ForcedCase | StaticCase, quality: Quality, checkpoint: Path | None = None,
              checkpoint_every: int = 2000, threads: int | None = None,
              progress: Callable[[str], None] | None = None, label: str = "",
-             observe: Callable[[object], None] | None = None) -> ForceRecord:
+             observe: Callable[[object], None] | None = None, body_walls: str = "function") -> ForceRecord:
     """Run one case - forced motion for :meth:`ForcedCase.end_time` (the caller drops the first
     :meth:`ForcedCase.discarded_periods`, :func:`whole_periods`), or a section held still for
     ``quality.static_duration`` - and return the whole force record.  ``shape``: the section's polygon,
@@ -373,13 +373,19 @@ def run_case(shape, case: ForcedCase | StaticCase, quality: Quality, checkpoint:
     raises DivergedError (exit status 3); a section the preset's grid cannot hold, InputError (2).
     ``observe``: called with the flow after every step (after a resume: every step run here) - for a diagnostic
     that needs the fields, such as the plate's surface pressure of tools/plate_loading.py; on the overset grid
-    the flow is a ``bridge.cfd.OversetPair``, whose ``body`` simulation moves with the section."""
+    the flow is a ``bridge.cfd.OversetPair``, whose ``body`` simulation moves with the section.
+    ``body_walls``: the SST model's treatment of the section's walls (``bridge.cfd.KOmegaSST``; "function", the
+    stage's, or "resolved", for a diagnostic such as tools/plate_loading.py's); a checkpoint's key does not hold
+    it, so another treatment runs without one."""
     from bridge.cfd import FlowDiverged
 
     q = quality
+    if body_walls != "function" and checkpoint is not None:
+        raise ValueError(f"body_walls {body_walls!r}: runs without a checkpoint (its key holds the wall function's)")
     polys = _polygons(shape)
     try:
-        flow = _overset_flow(q, polys, case, threads) if q.overset else _SingleGridFlow(q, polys, case, threads)
+        flow = (_overset_flow(q, polys, case, threads, body_walls) if q.overset
+                else _SingleGridFlow(q, polys, case, threads, body_walls))
     except ValueError as err:   # the section and the preset's grid do not fit together
         raise InputError("aero.quality", q.name, f"its {'overset' if q.overset else 'single'} grid cannot hold "
                          f"this section and motion ({err})") from None
@@ -541,7 +547,7 @@ class _SingleGridFlow:
     ``n_steps``, ``last_force`` (summed over the parts), ``step``, ``stable_dt``, ``simulations``,
     ``n_cells``, ``describe``, ``checkpoint_arrays`` / ``restore_arrays``."""
 
-    def __init__(self, q: Quality, polys, case, threads):
+    def __init__(self, q: Quality, polys, case, threads, body_walls: str = "function"):
         from bridge.cfd import BoundaryConditions, FlowConfig, Simulation
 
         radius = max(p.radius for p in polys)
@@ -558,7 +564,7 @@ class _SingleGridFlow:
         if q.turbulence == "sst":
             from bridge.cfd.turbulence import KOmegaSST, freestream_turbulence
 
-            self.model = KOmegaSST(self.sim, *freestream_turbulence(1.0, 1.0 / q.reynolds), body_walls="function")
+            self.model = KOmegaSST(self.sim, *freestream_turbulence(1.0, 1.0 / q.reynolds), body_walls=body_walls)
         self.simulations = [self.sim]
         self.n_cells = grid.nx * grid.ny
 
@@ -589,7 +595,7 @@ class _SingleGridFlow:
         self.sim.t, self.sim.n_steps = t, n_steps
 
 
-def _overset_flow(q: Quality, polys, case, threads):
+def _overset_flow(q: Quality, polys, case, threads, body_walls: str = "function"):
     """The section in a body grid that moves with it over a coarser fixed background
     (``bridge.cfd.OversetPair``, which has the flow interface of :class:`_SingleGridFlow`)."""
     from bridge.cfd import BoundaryConditions, CartesianGrid, FlowConfig, OversetPair
@@ -620,7 +626,7 @@ def _overset_flow(q: Quality, polys, case, threads):
     if q.turbulence == "sst":
         from bridge.cfd.turbulence import OversetSST, freestream_turbulence
 
-        OversetSST(pair, *freestream_turbulence(1.0, 1.0 / q.reynolds), body_walls="function")
+        OversetSST(pair, *freestream_turbulence(1.0, 1.0 / q.reynolds), body_walls=body_walls)
     return pair
 
 

@@ -237,3 +237,72 @@ def test_the_plates_surface_pressure_is_read_from_the_case_as_openfoam_writes_it
                 + _foam_list((3.0 * p).astype("<f8"), binary) + b"boundaryField\n{\n}\n", binary)
     averaged = of.plate_surface_pressure(case)
     assert averaged["field"] == "pMean" and averaged["upper"]["cp"] == pytest.approx(6 * p[:4])
+
+
+def test_the_eddy_viscosity_above_the_plate_is_read_from_the_cells_over_each_face(tmp_path):
+    """A block of 4 x 5 rectangular cells (uneven rows) standing on the plate's upper side, each cell holding a
+    known nut and velocity, written as OpenFOAM writes a mesh (owner and neighbour of every face): each face's
+    column gives its largest nut / nu below the asked height, and the face's own cell its height and its
+    velocity along the chord of the plate turned nose-up by 2 degrees (u cos a - v sin a)."""
+    of = load_tool("openfoam_plate")
+    xs = np.array([-0.5, -0.3, 0.0, 0.2, 0.5])
+    ys = 0.01 + np.array([0.0, 0.01, 0.03, 0.06, 0.1, 0.2])
+    nx, ny = xs.size - 1, ys.size - 1
+
+    def pid(i, j, k):
+        return 2 * (j * (nx + 1) + i) + k
+
+    def cid(i, j):
+        return j * nx + i
+
+    pts = np.array([[xs[i], ys[j], float(k)] for j in range(ny + 1) for i in range(nx + 1) for k in (0, 1)])
+    faces, owner, neighbour = [], [], []
+    for j in range(ny):                        # internal faces first: across x, then across y
+        for i in range(1, nx):
+            faces.append([pid(i, j, 0), pid(i, j + 1, 0), pid(i, j + 1, 1), pid(i, j, 1)])
+            owner.append(cid(i - 1, j))
+            neighbour.append(cid(i, j))
+    for j in range(1, ny):
+        for i in range(nx):
+            faces.append([pid(i, j, 0), pid(i, j, 1), pid(i + 1, j, 1), pid(i + 1, j, 0)])
+            owner.append(cid(i, j - 1))
+            neighbour.append(cid(i, j))
+    first = len(faces)
+    for i in range(nx):                        # the plate under row 0, then the block's other sides
+        faces.append([pid(i, 0, 0), pid(i, 0, 1), pid(i + 1, 0, 1), pid(i + 1, 0, 0)])
+        owner.append(cid(i, 0))
+    for i in range(nx):
+        faces.append([pid(i, ny, 0), pid(i + 1, ny, 0), pid(i + 1, ny, 1), pid(i, ny, 1)])
+        owner.append(cid(i, ny - 1))
+    for j in range(ny):
+        for i, side in ((0, 0), (nx, nx - 1)):
+            faces.append([pid(i, j, 0), pid(i, j, 1), pid(i, j + 1, 1), pid(i, j + 1, 0)])
+            owner.append(cid(side, j))
+    case = tmp_path / "case"
+    mesh = case / "constant" / "polyMesh"
+    _write_foam(mesh / "points", "vectorField", _foam_list(pts.astype("<f8"), True), True)
+    offsets = np.arange(len(faces) + 1, dtype="<i4") * 4
+    _write_foam(mesh / "faces", "faceCompactList", _foam_list(offsets, True)
+                + _foam_list(np.array(faces, dtype="<i4").ravel(), True), True)
+    _write_foam(mesh / "owner", "labelList", _foam_list(np.array(owner, dtype="<i4"), True), True)
+    _write_foam(mesh / "neighbour", "labelList", _foam_list(np.array(neighbour, dtype="<i4"), True), True)
+    (mesh / "boundary").write_text(f"FoamFile\n{{\n    format ascii;\n}}\n1\n(\n    plate\n    {{\n        type wall;\n"
+                                   f"        nFaces {nx};\n        startFace {first};\n    }}\n)\n")
+    rng = np.random.default_rng(3)
+    nut = rng.uniform(0.0, 1e-3, nx * ny)
+    velocity = rng.uniform(-1.0, 1.0, (nx * ny, 3))
+    head = b"dimensions [0 2 -1 0 0 0 0];\ninternalField nonuniform "
+    _write_foam(case / "20" / "p", "volScalarField", head + b"List<scalar> " + _foam_list(nut, True), True)
+    _write_foam(case / "20" / "nut", "volScalarField", head + b"List<scalar> " + _foam_list(nut, True), True)
+    _write_foam(case / "20" / "U", "volVectorField", head + b"List<vector> " + _foam_list(velocity, True), True)
+    nu = 1e-6
+    got = of.plate_eddy_viscosity(case, 2.0, nu, height=0.05)
+    assert got["x"] == pytest.approx([0.1, 0.35, 0.6, 0.85])
+    rows_below = np.nonzero(0.5 * (ys[:-1] + ys[1:]) - 0.01 < 0.05)[0]     # rows 0-2 (centres 0.005, 0.02, 0.045)
+    assert rows_below.tolist() == [0, 1, 2]
+    want = [max(nut[cid(i, j)] for j in rows_below) / nu for i in range(nx)]
+    assert got["nut_over_nu_max"] == pytest.approx(want)
+    assert got["first_cell_height"] == pytest.approx([0.005] * nx)
+    a = math.radians(2.0)
+    assert got["first_cell_u"] == pytest.approx([velocity[cid(i, 0), 0] * math.cos(a) - velocity[cid(i, 0), 1]
+                                                 * math.sin(a) for i in range(nx)])

@@ -13,7 +13,8 @@ from cfd_helpers import load_tool
                                           (["--cells-per-chord", "4"], "--cells-per-chord"),
                                           (["--dy-over-dx", "5"], "dy_over_dx"),
                                           (["--openfoam", "no_such_case"], "--openfoam"),
-                                          (["--quality", "superb"], "superb")])
+                                          (["--quality", "superb"], "superb"),
+                                          (["--turbulence", "laminar", "--body-walls", "resolved"], "--body-walls")])
 def test_bad_input_exits_2_naming_the_option_and_writes_nothing(tmp_path, capsys, argv, option):
     tool = load_tool("plate_loading")
     out = tmp_path / "loading"
@@ -39,6 +40,9 @@ def test_a_coarse_run_reads_the_pressure_on_both_sides_of_the_plate(tmp_path):
     assert up["ours"]["lift_from_pressure"] > 0
     total = up["ours"]["lift_from_pressure"]
     assert np.array(down["ours"]["strips"]) == pytest.approx(-np.array(up["ours"]["strips"]), abs=0.05 * total)
+    side = up["ours_upper_side"]
+    assert len(side["x"]) == len(side["nut_over_nu_max"]) == len(up["ours_delta_cp"]["x"])
+    assert min(side["nut_over_nu_max"]) > -1e-9 and 0 < min(side["first_cell_height"])
 
 
 def test_the_samples_are_the_first_cells_off_the_plate_that_no_forcing_touches():
@@ -49,3 +53,22 @@ def test_the_samples_are_the_first_cells_off_the_plate_that_no_forcing_touches()
     forced[7, 1] = True                       # a column where the forcing reaches one cell further up
     up, down = tool.surface_rows(forced, y, np.array([0, 1, 2]))
     assert up.tolist() == [7, 8, 7] and down.tolist() == [2, 2, 2]
+
+
+def test_the_upper_side_takes_the_largest_eddy_viscosity_below_the_height_and_the_first_free_cells_speed():
+    tool = load_tool("plate_loading")
+    y = (np.arange(10) - 4.5) * 0.02          # cell centres; the upper surface at 0.01
+    nut = np.arange(30.0).reshape(10, 3)       # grows upward and along x
+    u = np.tile(np.linspace(0.0, 0.9, 10)[:, None], (1, 3))
+    got = tool.upper_side_flow(nut, u, y, np.array([0, 2]), np.array([6, 7]), 0.01, height=0.05)
+    # centres above 0.01 and below 0.06: 0.03, 0.05 (rows 6, 7)
+    assert got["nut_over_nu_max"].tolist() == [nut[7, 0], nut[7, 2]]
+    assert got["first_cell_height"] == pytest.approx([0.02, 0.04])
+    assert got["first_cell_u"] == pytest.approx([u[6, 0], u[7, 2]])
+
+
+def test_another_wall_treatment_runs_without_a_checkpoint(tmp_path):
+    from bridge.aero.forced_motion import StaticCase, preset, run_case
+
+    with pytest.raises(ValueError, match="body_walls"):
+        run_case(None, StaticCase(2.0), preset("quick", "overset"), checkpoint=tmp_path / "c.h5", body_walls="resolved")
