@@ -15,7 +15,7 @@ Kernels are typed for float64 (the project's CFD precision, ``bridge.cfd.precisi
 
 import warp as wp
 
-from kernels.wall_law import wall_law_ratio
+from kernels.wall_law import wall_law_eddy_viscosity, wall_law_ratio
 
 # Advection schemes (integer codes used inside kernels; names in bridge.cfd.advection).
 SCHEME_CENTRAL = 0
@@ -517,6 +517,7 @@ def ib_targets(q: wp.array2d(dtype=wp.float64), phi: wp.array2d(dtype=wp.float64
                ilo: int, ihi: int, jlo: int, jhi: int, order: int, wall_law: int, nu: wp.float64,
                verts: wp.array(dtype=wp.vec2d), p: wp.array2d(dtype=wp.float64),
                hy_f: wp.array(dtype=wp.float64), cgrad: wp.float64, compensate: int,
+               nu_eff: wp.array2d(dtype=wp.float64),
                target: wp.array2d(dtype=wp.float64), state: wp.array2d(dtype=wp.int32)):
     """Direct-forcing target of each face in the box (state: 0 fluid, 1 solid, 2 interface).
 
@@ -601,7 +602,21 @@ def ib_targets(q: wp.array2d(dtype=wp.float64), phi: wp.array2d(dtype=wp.float64
                             tangential = (comp == 0 and dj != 0) or (comp == 1 and di != 0)
                             if wall_law != 0 and po > ph and tangential:
                                 if square_to_wall(x, y, pos, verts, di, dj):
-                                    r = wall_law_ratio(wp.abs(qo - qb), po, ph, nu)
+                                    r_wall = wall_law_ratio(wp.abs(qo - qb), po, ph, nu)
+                                    if wall_law == 2:
+                                        # blended: the wall law as far as the reference face's eddy
+                                        # viscosity (nu_eff - nu) reaches the law's own there
+                                        Jo = J - dj
+                                        Io = I - di
+                                        nuo = wp.float64(0.5) * (nu_eff[Jo, Io] + nu_eff[Jo - comp, Io - 1 + comp])
+                                        law = wall_law_eddy_viscosity(wp.abs(qo - qb), po, nu)
+                                        wgt = wp.float64(1.0)
+                                        if law > wp.float64(0.0):
+                                            wgt = wp.min(wp.max(wp.float64(2.0) * (nuo - nu) / law, wp.float64(0.0)),
+                                                         wp.float64(1.0))
+                                        r = r + wgt * (r_wall - r)
+                                    else:
+                                        r = r_wall
                             acc += qb + (qo - qb) * r
                         cnt += wp.float64(1.0)
                 if cnt > wp.float64(0.0):

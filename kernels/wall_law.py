@@ -87,3 +87,13 @@ def wall_law_ratio(speed: wp.float64, y_ref: wp.float64, y: wp.float64, nu: wp.f
             u_tau = speed / up_ref
             ratio = spalding_uplus(y * u_tau / nu) / up_ref
     return ratio
+
+
+@wp.func
+def wall_law_eddy_viscosity(speed: wp.float64, y: wp.float64, nu: wp.float64):
+    """The eddy viscosity of Spalding's profile at a point at distance y moving at ``speed`` relative to the
+    wall: nu (dy+/du+ - 1), which is kappa u_tau y in the log layer and vanishes in the sublayer."""
+    nut = wp.float64(0.0)
+    if speed > wp.float64(0.0) and y > wp.float64(0.0):
+        nut = nu * (spalding_slope(friction_uplus(speed * y / nu)) - wp.float64(1.0))
+    return nut

@@ -2,7 +2,7 @@
 
     python tools/plate_loading.py [--angle 2] [--turbulence sst --reynolds 1e6] [--cells-per-chord 40]
                                   [--dy-over-dx 0.25] [--quality standard] [--duration 20]
-                                  [--body-walls function|resolved] [--openfoam CASE] [--out out/plate_loading]
+                                  [--sst-walls function|blended|resolved] [--openfoam CASE] [--out out/plate_loading]
 
 Why: our SST plate's moment per angle is 18-24 % below OpenFOAM's body-fitted plate's while the lifts agree
 within a few per cent (docs/aero.md), so the two codes carry the lift at different places along the chord.
@@ -20,9 +20,10 @@ over the last quarter where the case wrote pMean, else at its last time).
 Above the upper side it also gives, along the chord, the largest eddy viscosity (nu_t / nu) within 0.05 chord
 of the surface and the velocity along the chord in the first cell off the wall (ours: the first no forcing
 touches; OpenFOAM's: the face's own cell), time-averaged as the pressure (OpenFOAM's: at its last time): where a
-code's boundary layer is laminar, turbulent or reversed.  ``--body-walls resolved`` runs our SST with the
-plate's walls resolved instead of Spalding's wall function (a diagnostic: at Re 1e6 the first cells lie far
-above the viscous sublayer, so the wall shear is not right either; docs/aero.md).
+code's boundary layer is laminar, turbulent or reversed.  ``--sst-walls`` runs our SST with another treatment
+of the plate's walls than the stage's Spalding wall function (``Quality.sst_walls``): "blended", the wall
+function only where the layer is turbulent, or "resolved" (a diagnostic: at Re 1e6 the first cells lie far
+above the viscous sublayer, so the wall shear is not right; docs/aero.md).
 
 Writes ``loading.json`` and ``loading.png`` (Delta C_p and the eddy viscosity along the chord) to ``--out``.
 """
@@ -41,7 +42,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from bridge.aero.forced_motion import StaticCase, run_case  # noqa: E402
+from bridge.aero.forced_motion import SST_WALLS, StaticCase, run_case  # noqa: E402
 from bridge.aero.stage import _unit_polygon  # noqa: E402
 from bridge.aero.static import chordwise_loading  # noqa: E402
 from bridge.cfd.grids import GHOST  # noqa: E402
@@ -89,14 +90,13 @@ def surface_rows(forced: np.ndarray, y_centres: np.ndarray, columns: np.ndarray)
     return np.array(up), np.array(down)
 
 
-def our_loading(angle_deg: float, quality, thickness: float, threads: int | None,
-                body_walls: str = "function") -> dict:
+def our_loading(angle_deg: float, quality, thickness: float, threads: int | None) -> dict:
     """The plate held at ``angle_deg`` on ``quality`` (an overset preset); the loading, the eddy viscosity above
     the upper side (:func:`upper_side_flow`) and the force record's coefficients over the last quarter."""
     poly = _unit_polygon(FlatPlate(1.0, thickness))
     average = _FieldAverage(0.75 * quality.static_duration)
     rec = run_case(poly, StaticCase(angle_deg), quality, progress=_say, label=f"plate at {angle_deg:g} deg",
-                   threads=threads, observe=average, body_walls=body_walls)
+                   threads=threads, observe=average)
     flow = average.flow
     grid = flow.body.grid
     inner = (slice(GHOST, GHOST + grid.ny), slice(GHOST, GHOST + grid.nx))
@@ -193,13 +193,14 @@ def main(argv=None) -> int:
     ap.add_argument("--threads", type=int, default=None, help="threads of the step (default: by grid size)")
     ap.add_argument("--openfoam", type=Path, default=None, metavar="CASE",
                     help="a case of tools/openfoam_plate.py --dof static at the same angle, shown beside ours")
-    ap.add_argument("--body-walls", choices=("function", "resolved"), default="function",
-                    help="with SST: the plate's walls by Spalding's wall function (default; the aero stage's) or as a "
-                         "resolved wall (a diagnostic: its first cells lie far above the viscous sublayer)")
+    ap.add_argument("--sst-walls", choices=SST_WALLS, default="function",
+                    help="with SST, the plate's walls: Spalding's wall function (default; the aero stage's), blended "
+                         "with the no-slip profile where the layer is not turbulent, or resolved (a diagnostic: the "
+                         "first cells lie far above the viscous sublayer)")
     ap.add_argument("--out", type=Path, default=Path("out/plate_loading"), help="folder (default out/plate_loading)")
     args = ap.parse_args(argv)
-    if args.body_walls != "function" and args.turbulence != "sst":
-        ap.error(f"--body-walls: {args.body_walls} needs --turbulence sst (a laminar plate has resolved walls)")
+    if args.sst_walls != "function" and args.turbulence != "sst":
+        ap.error(f"--sst-walls: {args.sst_walls} needs --turbulence sst (a laminar plate has resolved walls)")
     for name, value, ok, allowed in (
             ("--angle", args.angle, 0.0 < abs(args.angle) <= 10.0, "0 < |angle| <= 10 degrees"),
             ("--reynolds", args.reynolds, args.reynolds > 0, "> 0"),
@@ -213,16 +214,16 @@ def main(argv=None) -> int:
         ap.error(f"--openfoam: {args.openfoam} is no OpenFOAM case (no constant/polyMesh/boundary)")
     try:
         q = plate_quality(args.quality, "overset", args.turbulence, args.reynolds,
-                          {"cells_per_chord": args.cells_per_chord, "dy_over_dx": args.dy_over_dx})
+                          {"cells_per_chord": args.cells_per_chord, "dy_over_dx": args.dy_over_dx}, args.sst_walls)
         q = replace(q, static_duration=args.duration)
         check_output_root(args.out)
     except (InputError, KeyError, ValueError) as err:
         ap.error(str(err))
-    ours = our_loading(args.angle, q, args.thickness, args.threads, args.body_walls)
+    ours = our_loading(args.angle, q, args.thickness, args.threads)
     loading = ours["loading"]
     result = {"angle_deg": args.angle, "turbulence": args.turbulence, "reynolds": args.reynolds,
               "thickness": args.thickness, "quality": args.quality, "cells_per_chord": q.cells_per_chord,
-              "dy_over_dx": q.dy_over_dx, "body_walls": args.body_walls,
+              "dy_over_dx": q.dy_over_dx, "sst_walls": args.sst_walls,
               "duration": args.duration, "cells": ours["cells"], "grids": ours["grids"], "wall_s": ours["wall_s"],
               "sample_height_cells": ours["sample_height_cells"], "ours": loading.as_dict(),
               "ours_force_record": ours["record"], "ours_delta_cp": {"x": ours["x"].tolist(),

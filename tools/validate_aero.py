@@ -30,6 +30,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 from bridge.aero.forced_motion import (  # noqa: E402
     GRIDS,
     QUALITY,
+    SST_WALLS,
     THESIS_HEAVE_RATE,
     THESIS_PITCH_RATE,
     ForcedCase,
@@ -54,12 +55,13 @@ GRID_FIELDS = ("cells_per_chord", "dy_over_dx", "background_coarsening")
 
 
 def plate_quality(quality: str, grid: str, turbulence: str = "laminar", reynolds: float | None = None,
-                  grid_overrides: dict | None = None):
-    """The preset on ``grid``; with ``turbulence = "sst"`` the k-omega SST model at ``reynolds``;
-    ``grid_overrides`` replaces fields of GRID_FIELDS (checked by Quality: InputError names the field)."""
+                  grid_overrides: dict | None = None, sst_walls: str = "function"):
+    """The preset on ``grid``; with ``turbulence = "sst"`` the k-omega SST model at ``reynolds`` with the plate's
+    walls treated by ``sst_walls`` (Quality.sst_walls); ``grid_overrides`` replaces fields of GRID_FIELDS
+    (checked by Quality: InputError names the field)."""
     q = preset(quality, grid)
     if turbulence != "laminar":
-        q = replace(q, turbulence=turbulence, reynolds=float(reynolds))
+        q = replace(q, turbulence=turbulence, reynolds=float(reynolds), sst_walls=sst_walls)
     elif reynolds is not None:
         q = replace(q, reynolds=float(reynolds))
     overrides = {k: v for k, v in (grid_overrides or {}).items() if v is not None}
@@ -97,11 +99,11 @@ def resolution_warnings(q, thickness: float) -> list[str]:
 def plate_derivatives(reduced_velocity: float, quality: str, thickness: float, say=print,
                       runs: Path | None = None, grid: str = "single", turbulence: str = "laminar",
                       reynolds: float | None = None, threads: int | None = None,
-                      grid_overrides: dict | None = None, dofs=("heave", "pitch")) -> dict:
+                      grid_overrides: dict | None = None, dofs=("heave", "pitch"), sst_walls: str = "function") -> dict:
     """One heave and one pitch run (``dofs``: one of them alone gives only its four derivatives, the
     others None) at ``reduced_velocity``; a row of the derivatives beside Theodorsen's."""
     poly = _unit_polygon(FlatPlate(1.0, thickness))
-    q = plate_quality(quality, grid, turbulence, reynolds, grid_overrides)
+    q = plate_quality(quality, grid, turbulence, reynolds, grid_overrides, sst_walls)
     K = 2 * np.pi / reduced_velocity
     h, wall = {}, 0.0
     for dof in dofs:
@@ -135,12 +137,12 @@ def plate_derivatives(reduced_velocity: float, quality: str, thickness: float, s
 def multi_frequency_check(reduced_velocities, quality: str, thickness: float, singles: list[dict], say=print,
                           runs: Path | None = None, grid: str = "single", turbulence: str = "laminar",
                           reynolds: float | None = None, threads: int | None = None,
-                          grid_overrides: dict | None = None) -> list:
+                          grid_overrides: dict | None = None, sst_walls: str = "function") -> list:
     """One heave and one pitch run at all the reduced velocities at once (ForcedCase.multi_frequency, each
     sine at the single run's amplitude) against the single runs ``singles``: rows of
     (U/(fB), name, multi, single, |multi - single| / |single|)."""
     poly = _unit_polygon(FlatPlate(1.0, thickness))
-    q = plate_quality(quality, grid, turbulence, reynolds)
+    q = plate_quality(quality, grid, turbulence, reynolds, grid_overrides, sst_walls)
     Ks = tuple(sorted(2 * np.pi / np.asarray(reduced_velocities)))
     rows = []
     for dof, rate in (("heave", THESIS_HEAVE_RATE), ("pitch", THESIS_PITCH_RATE)):
@@ -173,6 +175,9 @@ def main(argv=None) -> int:
                     help="laminar at the preset's Reynolds number (default), or the k-omega SST model")
     ap.add_argument("--reynolds", type=float, default=None,
                     help="Reynolds number on the chord (default: the preset's; needed with --turbulence sst)")
+    ap.add_argument("--sst-walls", default="function", choices=SST_WALLS,
+                    help="with SST, the plate's walls (Quality.sst_walls): Spalding's wall function (default, the "
+                         "stage's), blended with the no-slip profile where the layer is not turbulent, or resolved")
     ap.add_argument("--threads", type=int, default=None, help="CPU threads of each case (default: run_case's)")
     ap.add_argument("--cells-per-chord", type=int, default=None,
                     help="replace the preset's cells per chord (x spacing; a grid study beyond the presets)")
@@ -187,6 +192,8 @@ def main(argv=None) -> int:
         ap.error("--multi needs both --dofs (heave and pitch)")
     if args.turbulence == "sst" and args.reynolds is None:
         ap.error("--turbulence sst needs --reynolds (e.g. 1e6)")
+    if args.sst_walls != "function" and args.turbulence != "sst":
+        ap.error(f"--sst-walls: {args.sst_walls} needs --turbulence sst")
     if args.reynolds is not None and not 1.0 <= args.reynolds <= 1e10:
         ap.error(f"--reynolds: {args.reynolds} not allowed; allowed: 1 .. 1e10")
     if args.threads is not None and not 1 <= args.threads <= 64:
@@ -195,13 +202,13 @@ def main(argv=None) -> int:
         ap.error(f"--out: {args.out} is a folder; give the JSON file to write (e.g. {args.out / 'validate_aero.json'})")
     overrides = {k: getattr(args, k) for k in GRID_FIELDS}
     try:   # the preset checks the replaced fields: a bad value stops here, before any run
-        q = plate_quality(args.quality, args.grid, args.turbulence, args.reynolds, overrides)
+        q = plate_quality(args.quality, args.grid, args.turbulence, args.reynolds, overrides, args.sst_walls)
     except InputError as e:
         ap.error(str(e))
     for warning in resolution_warnings(q, args.thickness):
         print(f"WARNING: {warning}", file=sys.stderr)
     flow = {"turbulence": args.turbulence, "reynolds": args.reynolds, "threads": args.threads,
-            "grid_overrides": overrides}
+            "grid_overrides": overrides, "sst_walls": args.sst_walls}
     t0 = time.perf_counter()
     if args.multi:   # checked before the single runs: the multi run needs U_max / m
         AeroOptions(excitation="multi", reduced_velocities=tuple(args.reduced_velocities))

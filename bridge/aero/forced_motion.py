@@ -40,10 +40,11 @@ from bridge.errors import DivergedError, InputError, check_range
 
 __all__ = ["Quality", "QUALITY", "ForcedCase", "StaticCase", "ForceRecord", "run_case", "case_key",
            "checkpoint_path", "whole_periods", "run_cases", "default_workers", "preset", "GRIDS", "TURBULENCE",
-           "QUICK_UNTIL_2026_12_02",
+           "SST_WALLS", "QUICK_UNTIL_2026_12_02",
            "THESIS_HEAVE_RATE", "THESIS_PITCH_RATE"]
 
 TURBULENCE = ("laminar", "sst")
+SST_WALLS = ("function", "blended", "resolved")
 THESIS_HEAVE_RATE = 0.4 / 50.0            # udot_0 / V (thesis 5.3)
 THESIS_PITCH_RATE = 0.028 * 31.0 / 50.0   # thetadot_0 B / V (thesis 5.3)
 
@@ -77,12 +78,18 @@ class Quality:
     # "laminar", or "sst": the k-omega SST model (bridge.cfd.turbulence, the 2003 variant) with Spalding's
     # wall function on the section (either grid), at the deck's Reynolds number
     turbulence: str = "laminar"
+    # with "sst", the section's walls (bridge.cfd.KOmegaSST's body_walls): "function" (Spalding's wall
+    # function, the presets'), "blended" (the wall function where the layer next to the wall is turbulent,
+    # the no-slip linear profile where it is not; under study, docs/aero.md) or "resolved" (a diagnostic)
+    sst_walls: str = "function"
 
     def __post_init__(self):
         check_range("aero.cells_per_chord", self.cells_per_chord, 8, 2000)
         check_range("aero.dy_over_dx", self.dy_over_dx, 0.05, 1.0)
         if self.turbulence not in TURBULENCE:
             raise InputError("aero.turbulence", self.turbulence, f"one of {', '.join(TURBULENCE)}")
+        if self.sst_walls not in SST_WALLS:
+            raise InputError("aero.sst_walls", self.sst_walls, f"one of {', '.join(SST_WALLS)}")
         check_range("aero.reynolds", self.reynolds, 1.0, 1e6 if self.turbulence == "laminar" else 1e10)
         check_range("aero.static_duration", self.static_duration, 1.0, 1e4)
         check_range("aero.settle_time", self.settle_time, 0.0, 1e4)
@@ -362,7 +369,7 @@ def _load_checkpoint(path: Path, key: str, flow) -> dict | None:
 def run_case(shape, case: ForcedCase | StaticCase, quality: Quality, checkpoint: Path | None = None,
              checkpoint_every: int = 2000, threads: int | None = None,
              progress: Callable[[str], None] | None = None, label: str = "",
-             observe: Callable[[object], None] | None = None, body_walls: str = "function") -> ForceRecord:
+             observe: Callable[[object], None] | None = None) -> ForceRecord:
     """Run one case - forced motion for :meth:`ForcedCase.end_time` (the caller drops the first
     :meth:`ForcedCase.discarded_periods`, :func:`whole_periods`), or a section held still for
     ``quality.static_duration`` - and return the whole force record.  ``shape``: the section's polygon,
@@ -373,19 +380,13 @@ def run_case(shape, case: ForcedCase | StaticCase, quality: Quality, checkpoint:
     raises DivergedError (exit status 3); a section the preset's grid cannot hold, InputError (2).
     ``observe``: called with the flow after every step (after a resume: every step run here) - for a diagnostic
     that needs the fields, such as the plate's surface pressure of tools/plate_loading.py; on the overset grid
-    the flow is a ``bridge.cfd.OversetPair``, whose ``body`` simulation moves with the section.
-    ``body_walls``: the SST model's treatment of the section's walls (``bridge.cfd.KOmegaSST``; "function", the
-    stage's, or "resolved", for a diagnostic such as tools/plate_loading.py's); a checkpoint's key does not hold
-    it, so another treatment runs without one."""
+    the flow is a ``bridge.cfd.OversetPair``, whose ``body`` simulation moves with the section."""
     from bridge.cfd import FlowDiverged
 
     q = quality
-    if body_walls != "function" and checkpoint is not None:
-        raise ValueError(f"body_walls {body_walls!r}: runs without a checkpoint (its key holds the wall function's)")
     polys = _polygons(shape)
     try:
-        flow = (_overset_flow(q, polys, case, threads, body_walls) if q.overset
-                else _SingleGridFlow(q, polys, case, threads, body_walls))
+        flow = _overset_flow(q, polys, case, threads) if q.overset else _SingleGridFlow(q, polys, case, threads)
     except ValueError as err:   # the section and the preset's grid do not fit together
         raise InputError("aero.quality", q.name, f"its {'overset' if q.overset else 'single'} grid cannot hold "
                          f"this section and motion ({err})") from None
@@ -547,7 +548,7 @@ class _SingleGridFlow:
     ``n_steps``, ``last_force`` (summed over the parts), ``step``, ``stable_dt``, ``simulations``,
     ``n_cells``, ``describe``, ``checkpoint_arrays`` / ``restore_arrays``."""
 
-    def __init__(self, q: Quality, polys, case, threads, body_walls: str = "function"):
+    def __init__(self, q: Quality, polys, case, threads):
         from bridge.cfd import BoundaryConditions, FlowConfig, Simulation
 
         radius = max(p.radius for p in polys)
@@ -564,7 +565,7 @@ class _SingleGridFlow:
         if q.turbulence == "sst":
             from bridge.cfd.turbulence import KOmegaSST, freestream_turbulence
 
-            self.model = KOmegaSST(self.sim, *freestream_turbulence(1.0, 1.0 / q.reynolds), body_walls=body_walls)
+            self.model = KOmegaSST(self.sim, *freestream_turbulence(1.0, 1.0 / q.reynolds), body_walls=q.sst_walls)
         self.simulations = [self.sim]
         self.n_cells = grid.nx * grid.ny
 
@@ -595,7 +596,7 @@ class _SingleGridFlow:
         self.sim.t, self.sim.n_steps = t, n_steps
 
 
-def _overset_flow(q: Quality, polys, case, threads, body_walls: str = "function"):
+def _overset_flow(q: Quality, polys, case, threads):
     """The section in a body grid that moves with it over a coarser fixed background
     (``bridge.cfd.OversetPair``, which has the flow interface of :class:`_SingleGridFlow`)."""
     from bridge.cfd import BoundaryConditions, CartesianGrid, FlowConfig, OversetPair
@@ -626,7 +627,7 @@ def _overset_flow(q: Quality, polys, case, threads, body_walls: str = "function"
     if q.turbulence == "sst":
         from bridge.cfd.turbulence import OversetSST, freestream_turbulence
 
-        OversetSST(pair, *freestream_turbulence(1.0, 1.0 / q.reynolds), body_walls=body_walls)
+        OversetSST(pair, *freestream_turbulence(1.0, 1.0 / q.reynolds), body_walls=q.sst_walls)
     return pair
 
 

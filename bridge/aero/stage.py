@@ -65,6 +65,7 @@ class AeroResult:
     grid: str = "single"               # [aero] grid: "single" or "overset"
     grids: str = ""                    # the grids in words, e.g. "480 x 144 cells"
     turbulence: str = "laminar"        # [aero] turbulence: "laminar" or "sst"
+    sst_walls: str = "function"        # [aero] sst_walls: "function" or "blended" (with "sst")
 
     @property
     def reduced_velocity(self) -> np.ndarray:
@@ -97,7 +98,8 @@ def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
     if aopts.turbulence != "laminar":   # the deck's own Reynolds number, with the SST model
         air = getattr(scenario, "air", None)
         nu_air = air.kinematic_viscosity_m2_s if air is not None else 1.48e-5
-        q = replace(q, turbulence=aopts.turbulence, reynolds=aopts.wind_speed_m_s * section.chord_m / nu_air)
+        q = replace(q, turbulence=aopts.turbulence, reynolds=aopts.wind_speed_m_s * section.chord_m / nu_air,
+                    sst_walls=aopts.sst_walls)
     poly = _unit_polygons(section)
     cells_across = (section.depth_m / section.chord_m) * q.cells_per_chord / q.dy_over_dx
     warning = ("" if cells_across >= 2.0 else
@@ -166,13 +168,17 @@ def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
     table.name = f"cfd ({section.name}, {quality}, Re {q.reynolds:.3g}{', SST' if q.turbulence == 'sst' else ''})"
     model = table if static is None else WithLateral(table, static.quasi_steady())
     data = AeroResult(section.describe(), quality, q.reynolds, cells, Ks, frf, stderr, model, tuple(records),
-                      warning, static, tuple(static_records), aopts.grid, grids, q.turbulence)
+                      warning, static, tuple(static_records), aopts.grid, grids, q.turbulence, q.sst_walls)
     return StageOutput(summary=_summary(data), write_h5=lambda g: _write_h5(g, data), report=_report(data),
                        figures=_figures(data), data=data)
 
 
 def _flow_model(q) -> str:
-    return "laminar" if q.turbulence == "laminar" else "k-omega SST-2003 with Spalding's wall function"
+    return "laminar" if q.turbulence == "laminar" else f"k-omega SST-2003 with {_WALLS[q.sst_walls]}"
+
+
+_WALLS = {"function": "Spalding's wall function", "blended": "Spalding's wall function where the layer is turbulent",
+          "resolved": "resolved walls"}
 
 
 # a multi-frequency run's load with more than this share of its moved-line amplitude at lines it was not moved
@@ -223,6 +229,7 @@ def _static_results(recs, section, aopts: AeroOptions, options: RunOptions):
 def _summary(d: AeroResult) -> dict[str, Any]:
     s: dict[str, Any] = {"aero.section": d.section, "aero.quality": d.quality, "aero.reynolds": d.reynolds,
                          "aero.turbulence": d.turbulence,
+                         **({"aero.sst_walls": d.sst_walls} if d.turbulence == "sst" else {}),
                          "aero.cases": len(d.records), "aero.grid_cells": d.cells, "aero.grid": d.grid,
                          "aero.reduced_velocity_min": float(d.reduced_velocity.min()),
                          "aero.reduced_velocity_max": float(d.reduced_velocity.max()),
@@ -246,6 +253,8 @@ def _write_h5(group: Any, d: AeroResult) -> None:
     group.attrs["grid"] = d.grid
     group.attrs["reynolds"] = d.reynolds
     group.attrs["turbulence"] = d.turbulence
+    if d.turbulence == "sst":
+        group.attrs["sst_walls"] = d.sst_walls
     write_dataset(group, "reduced_frequency", d.reduced_frequency, "1", f"({n},) K = Omega = w B / V of the runs")
     write_dataset(group, "reduced_velocity", d.reduced_velocity, "1", f"({n},) U / (f B) = 2 pi / K")
     for name in values_of(d):
@@ -301,7 +310,7 @@ def _report(d: AeroResult) -> str:
              f"{d.section}; preset {d.quality!r}, {d.grid} grid ({d.grids}), " + (
                  f"laminar at Re = {d.reynolds:g} (a low Reynolds number: the deck's, about 1e8, needs "
                  "[aero] turbulence = \"sst\")" if d.turbulence == "laminar" else
-                 f"URANS with the k-omega SST model (2003 variant) and Spalding's wall function at Re = "
+                 f"URANS with the k-omega SST model (2003 variant) and {_WALLS[d.sst_walls]} at Re = "
                  f"{d.reynolds:.3g}") + ".  Heave and pitch with the thesis's velocity amplitudes, transient "
              "periods dropped, a least-squares harmonic fit over the whole periods left (docs/aero.md).", ""]
     if d.warning:

@@ -80,6 +80,7 @@ class ImmersedBody:
             raise ValueError(f"order: interpolation order 1 or 2, got {order}")
         self.order = order
         self.wall_law = None   # molecular nu of the wall function (set_wall_function); None: no wall function
+        self._nu_eff = None    # nu + nu_t (cell storage) that blends the wall function (set_wall_function)
         self.polygon, self.motion, self.grid, self.L = polygon, motion, grid, launcher
         dev = launcher.device
         self.margin = margin
@@ -104,16 +105,19 @@ class ImmersedBody:
         self.inertia = polygon.polar_moment_centroid
         self._centroid_body = polygon.centroid
 
-    def set_wall_function(self, nu: float | None) -> None:
+    def set_wall_function(self, nu: float | None, nu_eff=None) -> None:
         """Interface faces take Spalding's law of the wall instead of the linear profile (a turbulent
         flow at high Reynolds number, ``kernels.cfd.ib_targets``; ``nu``: the molecular viscosity), or
-        the linear profile again (None). Needs ``order`` 1."""
+        the linear profile again (None). Needs ``order`` 1. With ``nu_eff`` (the flow's nu + nu_t, a Warp
+        array of cell storage) the law is blended with the linear profile by how far the reference face's
+        eddy viscosity reaches the law's own: the linear profile where the layer is not turbulent."""
         if nu is not None:
             if self.order != 1:
                 raise ValueError(f"the wall function needs interpolation order 1, not {self.order}")
             if not nu > 0:
                 raise ValueError(f"wall function: nu must be > 0, got {nu}")
         self.wall_law = None if nu is None else float(nu)
+        self._nu_eff = None if nu is None else nu_eff
 
     # --- geometry ------------------------------------------------------------------------------
     def _box(self, comp, pose):
@@ -156,6 +160,10 @@ class ImmersedBody:
                                               self.pos, i0, j0, ni, old["phi"]])
 
     # --- forcing -------------------------------------------------------------------------------
+    def _wall_code(self) -> int:
+        """``kernels.cfd.ib_targets``'s wall_law: 0 linear, 1 Spalding's law, 2 the law blended."""
+        return 0 if self.wall_law is None else (1 if self._nu_eff is None else 2)
+
     def apply(self, u, v, slot: int, p=None, c: float = 0.0):
         """Direct forcing on the predicted (u, v) in place; momentum added goes to ``acc[slot]``.
 
@@ -168,10 +176,11 @@ class ImmersedBody:
             ilo, ihi, jlo, jhi = self.limits[comp]
             self.L.once(_k.ib_targets, b["nj"], [q, b["phi"], self.x0, self.dx, self.xoff[comp], yc,
                                                  self.pos, self.vel, comp, b["i0"], b["j0"], b["ni"],
-                                                 ilo, ihi, jlo, jhi, self.order, int(self.wall_law is not None),
+                                                 ilo, ihi, jlo, jhi, self.order, self._wall_code(),
                                                  0.0 if self.wall_law is None else float(self.wall_law),
                                                  self.verts, p if p is not None else q, self.hy_v,
                                                  float(c), int(p is not None),
+                                                 q if self._nu_eff is None else self._nu_eff,
                                                  b["target"], b["state"]])
         self._close_targets()
         for comp, q in ((0, u), (1, v)):

@@ -65,7 +65,7 @@ class KOmegaSST:
     that are not bodies of this grid but count in its wall distance (an overset background: the body of
     the body grid at its starting pose)."""
 
-    BODY_WALLS = ("function", "resolved")
+    BODY_WALLS = ("function", "resolved", "blended")
 
     def __init__(self, sim, k_inf: float, omega_inf: float, body_walls: str = "function", far_walls=()):
         if not (k_inf >= 0 and omega_inf > 0):
@@ -105,7 +105,8 @@ class KOmegaSST:
                         "nj": 0, "pose": None, "phi": wp.zeros((1, 1), dtype=wp.float64, device=dev),
                         "ext": wp.zeros((1, 1), dtype=wp.float64, device=dev)} for b in bodies]
         for b in bodies:
-            b.set_wall_function(self.nu if body_walls == "function" else None)
+            b.set_wall_function(None if body_walls == "resolved" else self.nu,
+                                sim.nu if body_walls == "blended" else None)
         self.k = TransportedScalar(sim, "k", sides_k, initial=k_inf)
         self.omega = TransportedScalar(sim, "omega", sides_w, initial=omega_inf)
         self.update()
@@ -165,7 +166,7 @@ class KOmegaSST:
             vel = wp.vec3d(*(float(c) for c in body.motion.velocity(sim.t)))
             sim.L.once(_t.sst_body_walls, b["nj"],
                        [b["phi"], b["ext"], b["i0"], b["j0"], b["ni"], k.q, w.q, sim.u, sim.v, float(grid.x_faces[0]),
-                        grid.dx, self._yc, g, wp.vec3d(*b["pose"]), vel, self.nu, int(self.body_walls == "function"),
+                        grid.dx, self._yc, g, wp.vec3d(*b["pose"]), vel, self.nu, int(self.body_walls != "resolved"),
                         k.source, k.sink, w.source, w.sink, sim.nu, k.gamma, w.gamma])
         self.restored()
 

@@ -147,6 +147,23 @@ def test_the_grid_option_is_checked_and_picks_the_overset_pair():
         preset("quick", "chimera")
 
 
+def test_the_sst_walls_option_is_checked_reaches_the_preset_and_the_stage_key():
+    from dataclasses import replace as dc_replace
+
+    from bridge.aero.options import AeroOptions
+    from bridge.cache import stage_key
+    from bridge.config import load_scenario
+    from bridge.errors import InputError
+
+    with pytest.raises(InputError, match="aero.sst_walls.*function, blended"):
+        AeroOptions(sst_walls="log")
+    with pytest.raises(InputError, match="aero.sst_walls"):
+        dc_replace(preset("quick", "overset"), sst_walls="log")
+    sc = load_scenario("great_belt")
+    a, b = dc_replace(sc, aero=AeroOptions()), dc_replace(sc, aero=AeroOptions(sst_walls="blended"))
+    assert stage_key("aero", a, {}, False) != stage_key("aero", b, {}, False)
+
+
 def test_cases_side_by_side_give_the_numbers_of_cases_one_after_the_other(tmp_path):
     """run_cases with two worker processes (each case on one core) returns, in the jobs' order, the same
     records bit for bit as the cases run one after the other here, and passes their progress lines on;

@@ -14,7 +14,7 @@ from cfd_helpers import load_tool
                                           (["--dy-over-dx", "5"], "dy_over_dx"),
                                           (["--openfoam", "no_such_case"], "--openfoam"),
                                           (["--quality", "superb"], "superb"),
-                                          (["--turbulence", "laminar", "--body-walls", "resolved"], "--body-walls")])
+                                          (["--turbulence", "laminar", "--sst-walls", "resolved"], "--sst-walls")])
 def test_bad_input_exits_2_naming_the_option_and_writes_nothing(tmp_path, capsys, argv, option):
     tool = load_tool("plate_loading")
     out = tmp_path / "loading"
@@ -65,10 +65,3 @@ def test_the_upper_side_takes_the_largest_eddy_viscosity_below_the_height_and_th
     assert got["nut_over_nu_max"].tolist() == [nut[7, 0], nut[7, 2]]
     assert got["first_cell_height"] == pytest.approx([0.02, 0.04])
     assert got["first_cell_u"] == pytest.approx([u[6, 0], u[7, 2]])
-
-
-def test_another_wall_treatment_runs_without_a_checkpoint(tmp_path):
-    from bridge.aero.forced_motion import StaticCase, preset, run_case
-
-    with pytest.raises(ValueError, match="body_walls"):
-        run_case(None, StaticCase(2.0), preset("quick", "overset"), checkpoint=tmp_path / "c.h5", body_walls="resolved")

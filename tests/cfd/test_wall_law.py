@@ -120,6 +120,54 @@ def test_the_wall_function_reconstructs_a_law_of_the_wall_profile_exactly():
 GHOST_COLS = (GHOST + 13, GHOST + 27)   # storage columns of u-faces at x = 0.13-0.27, inside the slab (0.1-0.3)
 
 
+@wp.kernel
+def _eddy(speed: wp.array(dtype=wp.float64), y: wp.array(dtype=wp.float64), nu: wp.float64,
+          out: wp.array(dtype=wp.float64)):
+    i = wp.tid()
+    out[i] = wl.wall_law_eddy_viscosity(speed[i], y[i], nu)
+
+
+def test_the_laws_eddy_viscosity_is_nu_times_dyplus_duplus_less_one_and_kappa_u_tau_y_in_the_log_layer():
+    nu, u_tau = 1e-5, 0.05
+    up = np.array([0.25, 2.0, 12.0, 25.0, 30.0])
+    yp = yplus(up)
+    z = KAPPA * up
+    slope = 1 + np.exp(-KAPPA * B) * KAPPA * (np.exp(z) - 1 - z - z ** 2 / 2)     # d y+ / d u+ of the closed form
+    (got,) = _run(_eddy, up.size, [u_tau * up, yp * nu / u_tau, nu], 1)
+    np.testing.assert_allclose(got, nu * (slope - 1), rtol=1e-9)
+    assert got[0] < 1e-4 * nu                                                 # the sublayer: none
+    np.testing.assert_allclose(got[3:], KAPPA * u_tau * yp[3:] * nu / u_tau, rtol=0.02)   # log layer: kappa u_tau y
+
+
+def test_the_blended_wall_function_is_linear_without_eddy_viscosity_and_the_law_with_the_laws_own():
+    """The blended wall function (``set_wall_function(nu, nu_eff)``) on the slab: the target is the linear
+    profile's where the reference face has no eddy viscosity, Spalding's where it has at least half the law's
+    nu (dy+/du+ - 1) there, and halfway where it has a quarter (the weight min(1, 2 nu_t / nu_t,law))."""
+    nu, u_tau = 1e-5, 0.05
+    targets = {}
+    for name, wall_function in (("linear", False), ("law", True)):
+        sim, body, _ = _slab_flow()
+        J, I, _, after = _forced_u(sim, body, wall_function=wall_function)
+        keep = (I > GHOST_COLS[0]) & (I < GHOST_COLS[1])
+        top, cols = J[keep], I[keep]
+        targets[name] = after[top, cols]
+    rows = set(top.tolist())
+    assert len(rows) == 1 and np.all(np.abs(targets["law"] / targets["linear"] - 1) > 0.1)
+    sim, body, profile = _slab_flow()
+    y_ref = sim.grid.storage_y_centres()[top[0] + 1]          # the reference face, one row up
+    up_ref = profile(y_ref) / u_tau
+    z = KAPPA * up_ref
+    law = nu * np.exp(-KAPPA * B) * KAPPA * (np.exp(z) - 1 - z - z ** 2 / 2)
+    for share, want in ((0.0, targets["linear"]), (0.25, 0.5 * (targets["linear"] + targets["law"])),
+                        (0.5, targets["law"]), (3.0, targets["law"])):
+        sim, body, _ = _slab_flow()
+        sim.nu.fill_(nu + share * law)
+        body.set_wall_function(nu, sim.nu)
+        body.update(0.0)
+        body.apply(sim.u, sim.v, 0)
+        np.testing.assert_allclose(sim.u.numpy()[top, cols], want, rtol=1e-9, err_msg=f"share {share}")
+
+
 def test_the_sst_wall_cells_hold_omega_at_the_blended_wall_value_and_k_free_of_wall_flux():
     """After one step of the model on the slab: fluid cells within a cell of the wall hold omega =
     sqrt(omega_vis^2 + omega_log^2) of their k and distance, take nu_t = k / omega, and produce k at
@@ -172,7 +220,7 @@ def test_the_wall_function_refuses_what_it_cannot_do():
     body.order = 1
     with pytest.raises(ValueError, match="nu must be > 0"):
         body.set_wall_function(0.0)
-    with pytest.raises(ValueError, match="body_walls: one of function, resolved"):
+    with pytest.raises(ValueError, match="body_walls: one of function, resolved, blended"):
         KOmegaSST(sim, 1e-3, 10.0, body_walls="log")
 
 
