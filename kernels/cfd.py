@@ -539,6 +539,11 @@ def ib_targets(q: wp.array2d(dtype=wp.float64), phi: wp.array2d(dtype=wp.float64
     component across a line that meets an inclined wall obliquely: there it is mostly the normal
     velocity (v on a horizontal line against the deck's 28-degree bottom panels), and the wall law on it
     let the flow through the wall at the trailing edge until the run diverged (docs/aero.md).
+    ``wall_law`` 2: the same law blended with the linear profile, r = r_lin + w (r_law - r_lin), by the
+    reference face's eddy viscosity against the law's own there (``nu_eff``: the flow's nu + nu_t, cells;
+    w = min(1, 2 (nu_eff - nu) / nu_t,law), nu_t,law = nu (dy+/du+ - 1), ``kernels.wall_law``): where the layer
+    is laminar (the SST plate's leading edge, nu_t ~ 0) the wall is no-slip and the layer can separate; where it
+    is a developed turbulent layer (nu_t 0.9-1.0 of the law's at the reference face on TMR's plate) the law.
     Only faces with ilo <= I < ihi and jlo <= J < jhi are updated (boundary faces excluded);
     reads ``q`` and writes ``target``/``state`` only, so the result does not depend on order.
     """

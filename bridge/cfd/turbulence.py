@@ -28,7 +28,8 @@ Boundaries: an inflow side takes the freestream (k_inf, omega_inf); an outflow o
 gradient; a no-slip side k = 0 and omega = 60 nu / (beta_1 dy_1^2) on the wall (dy_1 the height of
 the first cell: Menter's wall value, as TMR recommends), valid when the first cell is in the viscous
 sublayer (y+ of order 1). Walls of immersed bodies: ``KOmegaSST``'s ``body_walls`` (Spalding's wall
-function or a resolved wall; ``kernels.transport.sst_body_walls``). On an overset pair: ``OversetSST``.
+function, the same blended with the resolved wall's linear profile where the layer is laminar, or a resolved
+wall; ``kernels.transport.sst_body_walls``, ``kernels.cfd.ib_targets``). On an overset pair: ``OversetSST``.
 """
 
 from __future__ import annotations
@@ -60,8 +61,11 @@ def freestream_turbulence(u_inf: float, nu: float, intensity: float = 0.001,
 class KOmegaSST:
     """SST-2003 on a ``Simulation``'s grid (module doc), with the walls of its immersed bodies
     (``sim.bodies``) treated by ``body_walls``: "function" (Spalding's wall function: for walls whose
-    first fluid point may lie in the log layer, the deck at full scale) or "resolved" (k = 0 at the wall,
-    for grids with the first point in the viscous sublayer). ``far_walls``: (polygon, pose) pairs of walls
+    first fluid point may lie in the log layer, the deck at full scale), "blended" (the same k and omega at
+    the wall, but the velocity forced to Spalding's profile only as far as the eddy viscosity next to the wall
+    reaches the law's, the linear no-slip profile where the layer is laminar: a laminar layer can then
+    separate at a corner, where the wall function lets it slip; docs/aero.md) or "resolved" (k = 0 at the
+    wall, for grids with the first point in the viscous sublayer). ``far_walls``: (polygon, pose) pairs of walls
     that are not bodies of this grid but count in its wall distance (an overset background: the body of
     the body grid at its starting pose)."""
 
