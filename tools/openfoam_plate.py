@@ -654,8 +654,8 @@ def plate_eddy_viscosity(case: Path, angle_deg: float, nu: float, height: float 
     """Along the plate's upper side at ``time`` (default: the latest written): the largest eddy viscosity over
     nu in the cells within ``height`` (chords) above each face, and the velocity along the chord (leading to
     trailing edge; the plate turned nose-up by ``angle_deg``) in the face's own cell, the first off the wall.
-    The cells are placed as written at the start (constant/polyMesh); the mesh deforms round the turning plate,
-    which moves cells this close to it as the plate (0.2 % of their distance from the mid-chord at 2 degrees).
+    The cells are placed as written at the start (constant/polyMesh), the plate's own frame, as the pressure
+    reader's faces are: the mesh deforms round the turning plate so that the cells this close to it turn with it.
     Returns ``x`` (from the leading edge), ``nut_over_nu_max``, ``first_cell_height`` and ``first_cell_u``."""
     folder = _time_folder(case, time)
     mesh = _PlateMesh(case)

@@ -241,7 +241,8 @@ def test_the_plates_surface_pressure_is_read_from_the_case_as_openfoam_writes_it
 
 def test_the_eddy_viscosity_above_the_plate_is_read_from_the_cells_over_each_face(tmp_path):
     """A block of 4 x 5 rectangular cells (uneven rows) standing on the plate's upper side, each cell holding a
-    known nut and velocity, written as OpenFOAM writes a mesh (owner and neighbour of every face): each face's
+    known nut and velocity, written as OpenFOAM writes a mesh (owner and neighbour of every face; the front and back
+faces left out, as they move no centre in x or y): each face's
     column gives its largest nut / nu below the asked height, and the face's own cell its height and its
     velocity along the chord of the plate turned nose-up by 2 degrees (u cos a - v sin a)."""
     of = load_tool("openfoam_plate")
