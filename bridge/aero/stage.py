@@ -101,15 +101,7 @@ def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
         q = replace(q, turbulence=aopts.turbulence, reynolds=aopts.wind_speed_m_s * section.chord_m / nu_air,
                     sst_walls=aopts.sst_walls)
     poly = _unit_polygons(section)
-    cells_across = (section.depth_m / section.chord_m) * q.cells_per_chord / q.dy_over_dx
-    warning = ("" if cells_across >= 2.0 else
-               f"the section is {cells_across:.1f} cells thick on the {quality!r} grid (fewer than 2): the immersed "
-               "boundary barely sees it and the forces are not to be trusted; use a finer preset")
-    if q.turbulence == "sst" and q.cells_per_chord > 80:
-        warning = "; ".join(w for w in (warning, (
-            f"SST on the {quality!r} preset ({q.cells_per_chord} cells per chord) is untested: the finest SST runs "
-            "had 80 cells per chord (the Great Belt deck's grid study, docs/aero.md); a run that diverges stops "
-            "with exit status 3")) if w)
+    warning = preset_warnings(q, quality, section)
     if warning:
         options.say(f"aero: WARNING {warning}")
     Ks = np.array(sorted(2 * np.pi / np.asarray(aopts.reduced_velocities)))
@@ -171,6 +163,24 @@ def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
                       warning, static, tuple(static_records), aopts.grid, grids, q.turbulence, q.sst_walls)
     return StageOutput(summary=_summary(data), write_h5=lambda g: _write_h5(g, data), report=_report(data),
                        figures=_figures(data), data=data)
+
+
+def preset_warnings(q, quality: str, section) -> str:
+    """What the stage warns of before its runs, for the preset ``q`` (named ``quality``) and the section:
+    a section fewer than 2 cells thick, SST finer than its tested grids, the blended wall (under study)."""
+    cells_across = (section.depth_m / section.chord_m) * q.cells_per_chord / q.dy_over_dx
+    notes = [] if cells_across >= 2.0 else [
+        f"the section is {cells_across:.1f} cells thick on the {quality!r} grid (fewer than 2): the immersed "
+        "boundary barely sees it and the forces are not to be trusted; use a finer preset"]
+    if q.turbulence == "sst" and q.cells_per_chord > 80:
+        notes.append(f"SST on the {quality!r} preset ({q.cells_per_chord} cells per chord) is untested: the finest SST "
+                     "runs had 80 cells per chord (the Great Belt deck's grid study, docs/aero.md); a run that "
+                     "diverges stops with exit status 3")
+    if q.turbulence == "sst" and q.sst_walls == "blended":
+        notes.append("[aero] sst_walls = \"blended\" is under study: it brought the thin plate onto a body-fitted "
+                     "code's, but on the Great Belt deck at Re 1e8 on the 16-cell 'quick' grid it turned the static "
+                     "lift slope negative and A2* positive (docs/aero.md, \"The wall function on a laminar layer\")")
+    return "; ".join(notes)
 
 
 def _flow_model(q) -> str:

@@ -162,6 +162,13 @@ def test_the_sst_walls_option_is_checked_reaches_the_preset_and_the_stage_key():
     sc = load_scenario("great_belt")
     a, b = dc_replace(sc, aero=AeroOptions()), dc_replace(sc, aero=AeroOptions(sst_walls="blended"))
     assert stage_key("aero", a, {}, False) != stage_key("aero", b, {}, False)
+    from bridge.aero.stage import preset_warnings
+    from bridge.cfd.sections import great_belt_section
+
+    sst = dc_replace(preset("quick", "overset"), turbulence="sst", reynolds=1e8)
+    assert preset_warnings(sst, "quick", great_belt_section()) == ""
+    blended = preset_warnings(dc_replace(sst, sst_walls="blended"), "quick", great_belt_section())
+    assert "under study" in blended and "lift slope negative" in blended
 
 
 def test_cases_side_by_side_give_the_numbers_of_cases_one_after_the_other(tmp_path):
