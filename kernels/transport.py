@@ -363,9 +363,15 @@ def sst_body_walls(phi: wp.array2d(dtype=wp.float64), ext: wp.array2d(dtype=wp.f
     u_tau from the cell's speed relative to the body (pos, vel: the body's pose and velocity) on
     Spalding's law, where the cell lies in the log layer (y+ > 10.8, where ln(y+)/0.41 + 5 meets y+; below,
     the model's own production): the strain rate of the cell itself spans the wall and would overstate
-    it. The production keeps the model's limiter, 10 beta* k omega. For the same reason these cells take
-    nu_t = k / omega unlimited (the limiter a1 k / (S F2) would act on that overstated S and halve the
-    eddy viscosity that carries the wall shear), with the inner diffusivities (F1 = 1 at a wall)."""
+    it. The production keeps the model's limiter, 10 beta* k omega. With ``function`` 2 ("equilibrium")
+    the production is the law's own, P = tau_w du/dn = u_tau^3 / (kappa phi), with no limiter: it does
+    not scale with the cell's k (the other form and its limiter go as sqrt(k) and k^1.5, so a layer that
+    enters with the freestream's k stays laminar), so the layer turns turbulent where its first cell lies
+    in the log layer, and k settles where P meets the destruction beta* k omega_log: k = u_tau^2 /
+    sqrt(beta*), nu_t = kappa u_tau phi, the law's eddy viscosity (the k-omega log-layer solution;
+    Wilcox 2006, "Turbulence Modeling for CFD", 3rd ed., ch. 4). These cells take nu_t = k / omega
+    unlimited, for the strain rate's reason (the limiter a1 k / (S F2) would act on that overstated S and
+    halve the eddy viscosity that carries the wall shear), with the inner diffusivities (F1 = 1 at a wall)."""
     jb = wp.tid()
     J = j0 + jb
     nj = phi.shape[0]
@@ -424,5 +430,8 @@ def sst_body_walls(phi: wp.array2d(dtype=wp.float64), ext: wp.array2d(dtype=wp.f
             if up > zero:
                 u_tau = speed / up
                 if ph * u_tau > SST_YPLUS_LOG * nu:   # in the log layer; below it the model's own production
-                    src_k[J, I] = wp.min(u_tau * u_tau * wp.sqrt(wp.sqrt(SST_BETA_STAR)) * sk / (KAPPA * ph),
-                                         wp.float64(10.0) * SST_BETA_STAR * sk * sk * w_log)
+                    if function == 2:   # the law's own: tau_w du/dn = u_tau^3 / (kappa phi), whatever k is
+                        src_k[J, I] = u_tau * u_tau * u_tau / (KAPPA * ph)
+                    else:
+                        src_k[J, I] = wp.min(u_tau * u_tau * wp.sqrt(wp.sqrt(SST_BETA_STAR)) * sk / (KAPPA * ph),
+                                             wp.float64(10.0) * SST_BETA_STAR * sk * sk * w_log)

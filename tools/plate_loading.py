@@ -2,7 +2,8 @@
 
     python tools/plate_loading.py [--angle 2] [--turbulence sst --reynolds 1e6] [--cells-per-chord 40]
                                   [--dy-over-dx 0.25] [--quality standard] [--duration 20]
-                                  [--sst-walls function|blended|resolved] [--openfoam CASE] [--out out/plate_loading]
+                                  [--sst-walls function|blended|equilibrium|resolved] [--openfoam CASE]
+                                  [--out out/plate_loading]
 
 Why: our SST plate's moment per angle is 18-24 % below OpenFOAM's body-fitted plate's while the lifts agree
 within a few per cent (docs/aero.md), so the two codes carry the lift at different places along the chord.
@@ -22,8 +23,9 @@ of the surface and the velocity along the chord in the first cell off the wall (
 touches; OpenFOAM's: the face's own cell), time-averaged as the pressure (OpenFOAM's: at its last time): where a
 code's boundary layer is laminar, turbulent or reversed.  ``--sst-walls`` runs our SST with another treatment
 of the plate's walls than the stage's Spalding wall function (``Quality.sst_walls``): "blended", the wall
-function only where the layer is turbulent, or "resolved" (a diagnostic: at Re 1e6 the first cells lie far
-above the viscous sublayer, so the wall shear is not right; docs/aero.md).
+function only where the layer is turbulent, "equilibrium", the wall function with the log layer's own
+production of k (the layer turbulent from the leading edge), or "resolved" (a diagnostic: at Re 1e6 the first
+cells lie far above the viscous sublayer, so the wall shear is not right; docs/aero.md).
 
 Writes ``loading.json`` and ``loading.png`` (Delta C_p and the eddy viscosity along the chord) to ``--out``.
 """

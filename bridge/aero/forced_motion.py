@@ -44,7 +44,7 @@ __all__ = ["Quality", "QUALITY", "ForcedCase", "StaticCase", "ForceRecord", "run
            "THESIS_HEAVE_RATE", "THESIS_PITCH_RATE"]
 
 TURBULENCE = ("laminar", "sst")
-SST_WALLS = ("function", "blended", "resolved")
+SST_WALLS = ("function", "blended", "equilibrium", "resolved")
 THESIS_HEAVE_RATE = 0.4 / 50.0            # udot_0 / V (thesis 5.3)
 THESIS_PITCH_RATE = 0.028 * 31.0 / 50.0   # thetadot_0 B / V (thesis 5.3)
 
@@ -80,7 +80,9 @@ class Quality:
     turbulence: str = "laminar"
     # with "sst", the section's walls (bridge.cfd.KOmegaSST's body_walls): "function" (Spalding's wall
     # function, the presets'), "blended" (the wall function where the layer next to the wall is turbulent,
-    # the no-slip linear profile where it is not; under study, docs/aero.md) or "resolved" (a diagnostic)
+    # the no-slip linear profile where it is not; under study, docs/aero.md), "equilibrium" (the wall function
+    # with the log layer's own k production, so the layer is turbulent from the front; under study) or
+    # "resolved" (a diagnostic)
     sst_walls: str = "function"
 
     def __post_init__(self):

@@ -28,7 +28,10 @@ Keys (all optional):
                           function everywhere; "blended": the wall function where the layer next to the wall
                           is turbulent (its eddy viscosity at least half the law's), the no-slip linear profile
                           where it is not, so that a laminar layer can separate at a corner (under study:
-                          docs/aero.md, "The wall function on a laminar layer")
+                          docs/aero.md, "The wall function on a laminar layer"); "equilibrium": the wall
+                          function with the log layer's own production of k, so that the layer is
+                          turbulent from the section's front, as a deck's at Re 1e8 is (under study:
+                          docs/aero.md, "A layer turbulent from the nose")
     wind_speed_m_s        the wind speed that sets the Reynolds number with turbulence = "sst" (default the
                           thesis's 50 m/s: Re = 1.05e8 for the Great Belt's 31 m); the derivatives are
                           per unit wind speed either way
@@ -70,8 +73,8 @@ class AeroOptions:
 
         if self.turbulence not in TURBULENCE:
             raise InputError("aero.turbulence", self.turbulence, f"one of {', '.join(TURBULENCE)}")
-        if self.sst_walls not in ("function", "blended"):
-            raise InputError("aero.sst_walls", self.sst_walls, "one of function, blended")
+        if self.sst_walls not in ("function", "blended", "equilibrium"):
+            raise InputError("aero.sst_walls", self.sst_walls, "one of function, blended, equilibrium")
         check_range("aero.wind_speed_m_s", self.wind_speed_m_s, 0.0, 200.0, low_open=True)
 
         if self.grid not in GRIDS:

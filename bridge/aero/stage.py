@@ -65,7 +65,7 @@ class AeroResult:
     grid: str = "single"               # [aero] grid: "single" or "overset"
     grids: str = ""                    # the grids in words, e.g. "480 x 144 cells"
     turbulence: str = "laminar"        # [aero] turbulence: "laminar" or "sst"
-    sst_walls: str = "function"        # [aero] sst_walls: "function" or "blended" (with "sst")
+    sst_walls: str = "function"        # [aero] sst_walls: "function", "blended" or "equilibrium" (with "sst")
 
     @property
     def reduced_velocity(self) -> np.ndarray:
@@ -188,7 +188,7 @@ def _flow_model(q) -> str:
 
 
 _WALLS = {"function": "Spalding's wall function", "blended": "Spalding's wall function where the layer is turbulent",
-          "resolved": "resolved walls"}
+          "equilibrium": "Spalding's wall function and the log layer's production of k", "resolved": "resolved walls"}
 
 
 # a multi-frequency run's load with more than this share of its moved-line amplitude at lines it was not moved

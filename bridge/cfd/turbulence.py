@@ -28,8 +28,9 @@ Boundaries: an inflow side takes the freestream (k_inf, omega_inf); an outflow o
 gradient; a no-slip side k = 0 and omega = 60 nu / (beta_1 dy_1^2) on the wall (dy_1 the height of
 the first cell: Menter's wall value, as TMR recommends), valid when the first cell is in the viscous
 sublayer (y+ of order 1). Walls of immersed bodies: ``KOmegaSST``'s ``body_walls`` (Spalding's wall
-function, the same blended with the resolved wall's linear profile where the layer is laminar, or a resolved
-wall; ``kernels.transport.sst_body_walls``, ``kernels.cfd.ib_targets``). On an overset pair: ``OversetSST``.
+function, the same blended with the resolved wall's linear profile where the layer is laminar, the same
+with the log layer's own production so the layer is turbulent from the front, or a resolved wall;
+``kernels.transport.sst_body_walls``, ``kernels.cfd.ib_targets``). On an overset pair: ``OversetSST``.
 """
 
 from __future__ import annotations
@@ -64,12 +65,16 @@ class KOmegaSST:
     first fluid point may lie in the log layer, the deck at full scale), "blended" (the same k and omega at
     the wall, but the velocity forced to Spalding's profile only as far as the eddy viscosity next to the wall
     reaches the law's, the linear no-slip profile where the layer is laminar: a laminar layer can then
-    separate at a corner, where the wall function lets it slip; docs/aero.md) or "resolved" (k = 0 at the
+    separate at a corner, where the wall function lets it slip; docs/aero.md), "equilibrium" (the wall
+    function with the log layer's own k production, u_tau^3 / (kappa d), whatever the cell's k: the layer is
+    turbulent wherever its first cell lies in the log layer, as a deck's at Re 1e8 is from its nose, where
+    the wall function's production, which scales with sqrt(k), leaves it laminar) or "resolved" (k = 0 at the
     wall, for grids with the first point in the viscous sublayer). ``far_walls``: (polygon, pose) pairs of walls
     that are not bodies of this grid but count in its wall distance (an overset background: the body of
     the body grid at its starting pose)."""
 
-    BODY_WALLS = ("function", "resolved", "blended")
+    BODY_WALLS = ("function", "resolved", "blended", "equilibrium")
+    _KERNEL_WALLS = {"resolved": 0, "function": 1, "blended": 1, "equilibrium": 2}   # sst_body_walls' ``function``
 
     def __init__(self, sim, k_inf: float, omega_inf: float, body_walls: str = "function", far_walls=()):
         if not (k_inf >= 0 and omega_inf > 0):
@@ -170,7 +175,7 @@ class KOmegaSST:
             vel = wp.vec3d(*(float(c) for c in body.motion.velocity(sim.t)))
             sim.L.once(_t.sst_body_walls, b["nj"],
                        [b["phi"], b["ext"], b["i0"], b["j0"], b["ni"], k.q, w.q, sim.u, sim.v, float(grid.x_faces[0]),
-                        grid.dx, self._yc, g, wp.vec3d(*b["pose"]), vel, self.nu, int(self.body_walls != "resolved"),
+                        grid.dx, self._yc, g, wp.vec3d(*b["pose"]), vel, self.nu, self._KERNEL_WALLS[self.body_walls],
                         k.source, k.sink, w.source, w.sink, sim.nu, k.gamma, w.gamma])
         self.restored()
 

@@ -210,6 +210,34 @@ def test_the_sst_wall_cells_hold_omega_at_the_blended_wall_value_and_k_free_of_w
     assert sim2.bodies[0].wall_law is None and sim.bodies[0].wall_law == nu
 
 
+def test_the_equilibrium_wall_produces_k_at_the_log_layers_rate_whatever_k_is():
+    """``body_walls="equilibrium"`` on the slab (first fluid cells at y+ 35 on Spalding's profile, u_tau 0.05):
+    those cells produce k at the law's rate tau_w du/dn = u_tau^3 / (kappa d), the same for the freestream-like
+    k = 1e-7 as for k = u_tau^2 / sqrt(beta*), where the wall function's production (u_tau^2 beta*^(1/4) sqrt(k)
+    / (kappa d) under the limiter 10 beta* k omega_log) is 4e-7 of it and the layer stays laminar; at the
+    log layer's k = u_tau^2 / sqrt(beta*) (Wilcox 2006, ch. 4) the production equals beta* k omega_log, the
+    destruction the cell holds without its sublayer part: the layer settles on the law's eddy viscosity."""
+    from bridge.cfd.turbulence import KOmegaSST
+
+    u_tau, beta_star, kappa = 0.05, 0.09, 0.41
+    k_log = u_tau ** 2 / np.sqrt(beta_star)
+    produced = {}
+    for walls in ("equilibrium", "function"):
+        for k0 in (1e-7, k_log):
+            sim, _, _ = _slab_flow(u_tau=u_tau, nu=1e-6)
+            model = KOmegaSST(sim, k0, 10.0, body_walls=walls)   # update(): the sources from the uniform k0
+            d_row = sim.grid.y_centres - 0.0213
+            first = int(np.nonzero(d_row > 0)[0][0])
+            d = d_row[first]
+            produced[walls, k0] = model.k.source.numpy()[GHOST + first, GHOST:GHOST + sim.grid.nx][12:28]
+    for k0 in (1e-7, k_log):
+        np.testing.assert_allclose(produced["equilibrium", k0], u_tau ** 3 / (kappa * d), rtol=1e-4)
+    omega_log = np.sqrt(k_log) / (beta_star ** 0.25 * kappa * d)
+    np.testing.assert_allclose(produced["equilibrium", k_log], beta_star * k_log * omega_log, rtol=1e-4)
+    assert np.all(produced["function", 1e-7] < 1e-6 * produced["equilibrium", 1e-7])
+    np.testing.assert_allclose(produced["function", k_log], produced["equilibrium", k_log], rtol=1e-4)
+
+
 def test_the_wall_function_refuses_what_it_cannot_do():
     from bridge.cfd.turbulence import KOmegaSST
 
