@@ -21,11 +21,12 @@ over the last quarter where the case wrote pMean, else at its last time).
 Above the upper side it also gives, along the chord, the largest eddy viscosity (nu_t / nu) within 0.05 chord
 of the surface and the velocity along the chord in the first cell off the wall (ours: the first no forcing
 touches; OpenFOAM's: the face's own cell), time-averaged as the pressure (OpenFOAM's: at its last time): where a
-code's boundary layer is laminar, turbulent or reversed.  ``--sst-walls`` runs our SST with another treatment
-of the plate's walls than the stage's Spalding wall function (``Quality.sst_walls``): "blended", the wall
-function only where the layer is turbulent, "equilibrium", the wall function with the log layer's own
-production of k (the layer turbulent from the leading edge), or "resolved" (a diagnostic: at Re 1e6 the first
-cells lie far above the viscous sublayer, so the wall shear is not right; docs/aero.md).
+code's boundary layer is laminar, turbulent or reversed.  ``--sst-walls`` chooses our SST's treatment of the
+plate's walls (``Quality.sst_walls``): "function" (default here, the documented plate runs': Spalding's wall
+function with the model's production of k), "blended", the wall function only where the layer is turbulent,
+"equilibrium", the wall function with the log layer's own production of k (the layer turbulent from the
+leading edge; the aero stage's default), or "resolved" (a diagnostic: at Re 1e6 the first cells lie far above
+the viscous sublayer, so the wall shear is not right; docs/aero.md).
 
 Writes ``loading.json`` and ``loading.png`` (Delta C_p and the eddy viscosity along the chord) to ``--out``.
 """
@@ -196,9 +197,10 @@ def main(argv=None) -> int:
     ap.add_argument("--openfoam", type=Path, default=None, metavar="CASE",
                     help="a case of tools/openfoam_plate.py --dof static at the same angle, shown beside ours")
     ap.add_argument("--sst-walls", choices=SST_WALLS, default="function",
-                    help="with SST, the plate's walls: Spalding's wall function (default; the aero stage's), blended "
-                         "with the no-slip profile where the layer is not turbulent, or resolved (a diagnostic: the "
-                         "first cells lie far above the viscous sublayer)")
+                    help="with SST, the plate's walls: Spalding's wall function with the model's k production "
+                         "(default: the documented plate runs'), blended with the no-slip profile where the layer is "
+                         "not turbulent, with the log layer's own k production (the aero stage's default), or "
+                         "resolved (a diagnostic: the first cells lie far above the viscous sublayer)")
     ap.add_argument("--out", type=Path, default=Path("out/plate_loading"), help="folder (default out/plate_loading)")
     args = ap.parse_args(argv)
     if args.sst_walls != "function" and args.turbulence != "sst":

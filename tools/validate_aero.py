@@ -176,9 +176,10 @@ def main(argv=None) -> int:
     ap.add_argument("--reynolds", type=float, default=None,
                     help="Reynolds number on the chord (default: the preset's; needed with --turbulence sst)")
     ap.add_argument("--sst-walls", default="function", choices=SST_WALLS,
-                    help="with SST, the plate's walls (Quality.sst_walls): Spalding's wall function (default, the "
-                         "stage's), blended with the no-slip profile where the layer is not turbulent, with the log "
-                         "layer's own k production (the layer turbulent from the front), or resolved")
+                    help="with SST, the plate's walls (Quality.sst_walls): Spalding's wall function with the model's "
+                         "k production (default: the documented plate runs'), blended with the no-slip profile where "
+                         "the layer is not turbulent, with the log layer's own k production (the layer turbulent from "
+                         "the front; the aero stage's default), or resolved")
     ap.add_argument("--threads", type=int, default=None, help="CPU threads of each case (default: run_case's)")
     ap.add_argument("--cells-per-chord", type=int, default=None,
                     help="replace the preset's cells per chord (x spacing; a grid study beyond the presets)")

@@ -44,7 +44,7 @@ __all__ = ["Quality", "QUALITY", "ForcedCase", "StaticCase", "ForceRecord", "run
            "THESIS_HEAVE_RATE", "THESIS_PITCH_RATE"]
 
 TURBULENCE = ("laminar", "sst")
-SST_WALLS = ("function", "blended", "equilibrium", "resolved")
+SST_WALLS = ("equilibrium", "function", "blended", "resolved")
 THESIS_HEAVE_RATE = 0.4 / 50.0            # udot_0 / V (thesis 5.3)
 THESIS_PITCH_RATE = 0.028 * 31.0 / 50.0   # thetadot_0 B / V (thesis 5.3)
 
@@ -78,12 +78,12 @@ class Quality:
     # "laminar", or "sst": the k-omega SST model (bridge.cfd.turbulence, the 2003 variant) with Spalding's
     # wall function on the section (either grid), at the deck's Reynolds number
     turbulence: str = "laminar"
-    # with "sst", the section's walls (bridge.cfd.KOmegaSST's body_walls): "function" (Spalding's wall
-    # function, the presets'), "blended" (the wall function where the layer next to the wall is turbulent,
-    # the no-slip linear profile where it is not; under study, docs/aero.md), "equilibrium" (the wall function
-    # with the log layer's own k production, so the layer is turbulent from the front; under study) or
-    # "resolved" (a diagnostic)
-    sst_walls: str = "function"
+    # with "sst", the section's walls (bridge.cfd.KOmegaSST's body_walls): "equilibrium" (Spalding's wall
+    # function with the log layer's own k production, so the layer is turbulent from the front: the presets'
+    # since 2026-12-04, docs/aero.md), "function" (the same wall function with the model's production, the
+    # presets' before), "blended" (the wall function where the layer next to the wall is turbulent, the
+    # no-slip linear profile where it is not; under study) or "resolved" (a diagnostic)
+    sst_walls: str = "equilibrium"
 
     def __post_init__(self):
         check_range("aero.cells_per_chord", self.cells_per_chord, 8, 2000)

@@ -24,14 +24,16 @@ Keys (all optional):
                           the section, at the deck's Reynolds number Re = wind_speed_m_s B / nu_air ([air]
                           kinematic viscosity), on either grid (bridge/cfd/turbulence.py, docs/cfd.md);
                           "laminar": the preset's low Reynolds number, no turbulence model
-    sst_walls             with turbulence = "sst", the section's walls: "function" (default): Spalding's wall
-                          function everywhere; "blended": the wall function where the layer next to the wall
-                          is turbulent (its eddy viscosity at least half the law's), the no-slip linear profile
+    sst_walls             with turbulence = "sst", the section's walls: "equilibrium" (default): Spalding's
+                          wall function everywhere, with the log layer's own production of k, so that the
+                          layer is turbulent from the section's front, as a deck's at Re 1e8 is
+                          (docs/aero.md, "A layer turbulent from the nose"); "function": the same wall
+                          function with the model's production of k, which leaves a layer that meets the
+                          section with the freestream's k laminar over much of it (the default until
+                          2026-12-04); "blended": the wall function where the layer next to the wall is
+                          turbulent (its eddy viscosity at least half the law's), the no-slip linear profile
                           where it is not, so that a laminar layer can separate at a corner (under study:
-                          docs/aero.md, "The wall function on a laminar layer"); "equilibrium": the wall
-                          function with the log layer's own production of k, so that the layer is
-                          turbulent from the section's front, as a deck's at Re 1e8 is (under study:
-                          docs/aero.md, "A layer turbulent from the nose")
+                          docs/aero.md, "The wall function on a laminar layer")
     wind_speed_m_s        the wind speed that sets the Reynolds number with turbulence = "sst" (default the
                           thesis's 50 m/s: Re = 1.05e8 for the Great Belt's 31 m); the derivatives are
                           per unit wind speed either way
@@ -66,15 +68,15 @@ class AeroOptions:
     grid: str = "overset"
     turbulence: str = "sst"
     wind_speed_m_s: float = 50.0
-    sst_walls: str = "function"
+    sst_walls: str = "equilibrium"
 
     def __post_init__(self):
         from bridge.aero.forced_motion import GRIDS, QUALITY, TURBULENCE
 
         if self.turbulence not in TURBULENCE:
             raise InputError("aero.turbulence", self.turbulence, f"one of {', '.join(TURBULENCE)}")
-        if self.sst_walls not in ("function", "blended", "equilibrium"):
-            raise InputError("aero.sst_walls", self.sst_walls, "one of function, blended, equilibrium")
+        if self.sst_walls not in ("equilibrium", "function", "blended"):
+            raise InputError("aero.sst_walls", self.sst_walls, "one of equilibrium, function, blended")
         check_range("aero.wind_speed_m_s", self.wind_speed_m_s, 0.0, 200.0, low_open=True)
 
         if self.grid not in GRIDS:

@@ -65,7 +65,7 @@ class AeroResult:
     grid: str = "single"               # [aero] grid: "single" or "overset"
     grids: str = ""                    # the grids in words, e.g. "480 x 144 cells"
     turbulence: str = "laminar"        # [aero] turbulence: "laminar" or "sst"
-    sst_walls: str = "function"        # [aero] sst_walls: "function", "blended" or "equilibrium" (with "sst")
+    sst_walls: str = "equilibrium"     # [aero] sst_walls: "equilibrium", "function" or "blended" (with "sst")
 
     @property
     def reduced_velocity(self) -> np.ndarray:

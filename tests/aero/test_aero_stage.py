@@ -155,7 +155,7 @@ def test_the_sst_walls_option_is_checked_reaches_the_preset_and_the_stage_key():
     from bridge.config import load_scenario
     from bridge.errors import InputError
 
-    with pytest.raises(InputError, match="aero.sst_walls.*function, blended, equilibrium"):
+    with pytest.raises(InputError, match="aero.sst_walls.*equilibrium, function, blended"):
         AeroOptions(sst_walls="log")
     with pytest.raises(InputError, match="aero.sst_walls"):
         dc_replace(preset("quick", "overset"), sst_walls="log")
