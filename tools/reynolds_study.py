@@ -2,7 +2,7 @@
 reduced frequency, Omega = 0.5, for two wind speeds (25 and 50 m/s), with the k-omega SST model.
 
     python tools/reynolds_study.py --quality quick --grid overset --speeds 25 50 [--omega 0.5]
-                                   [--out out/reynolds_study.json]
+                                   [--sst-walls equilibrium|function|blended] [--out out/reynolds_study.json]
 
 At one Omega the flow differs between the two speeds only through the Reynolds number Re = V B / nu (5.2e7
 and 1.05e8 for B = 31 m, nu = 1.48e-5 m^2/s, thesis 5.2.4), so a Reynolds-number-independent section gives
@@ -31,7 +31,16 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from bridge.aero.forced_motion import QUALITY, ForcedCase, checkpoint_path, preset, run_case, whole_periods  # noqa: E402
+from bridge.aero.forced_motion import (  # noqa: E402
+    QUALITY,
+    SST_WALLS,
+    ForcedCase,
+    Quality,
+    checkpoint_path,
+    preset,
+    run_case,
+    whole_periods,
+)
 from bridge.aero.frequency_response import forced_motion_response  # noqa: E402
 from bridge.aero.stage import _unit_polygons  # noqa: E402
 from bridge.cfd.sections import great_belt_section  # noqa: E402
@@ -54,7 +63,7 @@ def run_speed(speed: float, omega: float, quality: str, turbulence: str, runs: P
     if turbulence != "laminar":
         q = replace(q, turbulence=turbulence, reynolds=speed * section.chord_m / NU_AIR)
     row: dict = {"speed_m_s": speed, "reynolds": q.reynolds, "turbulence": q.turbulence, "quality": quality,
-                 "grid": grid,
+                 "grid": grid, **({"sst_walls": q.sst_walls} if q.turbulence == "sst" else {}),
                  "omega": omega, "angular_frequency_rad_s": omega * speed / section.chord_m, "cases": {}}
     for dof in ("heave", "pitch"):
         case = ForcedCase.thesis(dof, omega)
@@ -135,6 +144,8 @@ def main(argv=None) -> int:
                          "whose SST forces jitter as the deck's faces change class (docs/aero.md)")
     ap.add_argument("--threads", type=int, default=None,
                     help="CPU threads of each case (default: 2 on grids of 20 000 cells or more, else 1)")
+    ap.add_argument("--sst-walls", default=Quality.sst_walls, choices=SST_WALLS,
+                    help=f"with SST, the deck's walls (Quality.sst_walls; default {Quality.sst_walls!r}, the presets')")
     ap.add_argument("--out", default="out/reynolds_study.json")
     args = ap.parse_args(argv)
     if len(args.speeds) < 2 or any(not 1.0 <= v <= 200.0 for v in args.speeds):
@@ -143,7 +154,8 @@ def main(argv=None) -> int:
         ap.error(f"--omega: {args.omega} not allowed; allowed: 0.05 .. 5")
     out, runs = start_study(ap, args)
     rows = [run_speed(v, args.omega, args.quality, args.turbulence, runs,
-                      say=lambda s: print(s, file=sys.stderr, flush=True), grid=args.grid, threads=args.threads)
+                      say=lambda s: print(s, file=sys.stderr, flush=True), grid=args.grid, threads=args.threads,
+                      sst_walls=args.sst_walls)
             for v in sorted(args.speeds)]
     table = _table(rows)
     print(table)
