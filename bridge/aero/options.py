@@ -71,12 +71,13 @@ class AeroOptions:
     sst_walls: str = "equilibrium"
 
     def __post_init__(self):
-        from bridge.aero.forced_motion import GRIDS, QUALITY, TURBULENCE
+        from bridge.aero.forced_motion import GRIDS, QUALITY, SST_WALLS, TURBULENCE
 
         if self.turbulence not in TURBULENCE:
             raise InputError("aero.turbulence", self.turbulence, f"one of {', '.join(TURBULENCE)}")
-        if self.sst_walls not in ("equilibrium", "function", "blended"):
-            raise InputError("aero.sst_walls", self.sst_walls, "one of equilibrium, function, blended")
+        walls = tuple(w for w in SST_WALLS if w != "resolved")   # "resolved" is the tools' diagnostic only
+        if self.sst_walls not in walls:
+            raise InputError("aero.sst_walls", self.sst_walls, f"one of {', '.join(walls)}")
         check_range("aero.wind_speed_m_s", self.wind_speed_m_s, 0.0, 200.0, low_open=True)
 
         if self.grid not in GRIDS:
