@@ -4,7 +4,7 @@
     python tools/validate_turbulence.py channel --re-tau 395 # fully developed channel vs the log law
     python tools/validate_turbulence.py plate --nx 200 --t-end 2  # TMR flat plate (about 25 min)
     python tools/validate_turbulence.py ibplate --dy 4e-4 --t-end 2.5  # the same plate immersed, wall function
-                                                 [--walls blended|equilibrium]  # other wall treatments
+                                                 [--walls blended|equilibrium|resolved]  # other wall treatments
 
 decay: homogeneous turbulence at rest (no walls: F1 = 0, the outer constants), k0 = 0.01, omega0 = 1,
 to t = 4 with dt = 0.02, 0.01, 0.005. Closed form: omega = omega0 / (1 + beta_2 omega0 t),
@@ -293,10 +293,10 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("case", choices=["decay", "channel", "plate", "ibplate"])
     ap.add_argument("--dy", type=float, default=4e-4, help="ibplate: cell height at the plate (4e-4: y+ ~ 100)")
-    ap.add_argument("--walls", choices=["function", "blended", "equilibrium"], default="function",
+    ap.add_argument("--walls", choices=KOmegaSST.BODY_WALLS, default="function",
                     help="ibplate: Spalding's wall function everywhere (default), blended with the linear profile "
-                         "where the layer is not turbulent, or with the log layer's own k production so the layer is "
-                         "turbulent from the front (bridge.cfd.KOmegaSST's body_walls)")
+                         "where the layer is not turbulent, with the log layer's own k production so the layer is "
+                         "turbulent from the front, or no wall law (bridge.cfd.KOmegaSST's body_walls)")
     ap.add_argument("--nx", type=int, default=200, help="plate: cells along x in [0, 2]")
     ap.add_argument("--dy1", type=float, default=5e-6, help="plate: first cell height (Re 5e6: y+ ~ 1 is 5e-6)")
     ap.add_argument("--growth", type=float, default=1.12, help="plate: cell growth away from the wall")
