@@ -1,0 +1,202 @@
+"""The Great Belt deck's boundary layer over its top: laminar, turbulent, or short of the log layer
+(docs/aero.md, "The deck's own boundary layer" and "A layer turbulent from the nose").
+
+    python tools/deck_layer.py [--quality quick] [--angle 2] [--speed 50]
+                               [--sst-walls equilibrium|function|blended] [--duration 20] [--threads N]
+                               [--out out/deck_layer]
+
+Why: the SST deck's wall treatment decides whether its layer is turbulent from the nose, as it is at the
+deck's Reynolds number (1e8), and the wall function's velocity profile assumes that it is.  This tool holds
+the deck (``bridge.cfd.sections.great_belt_section``) at ``--angle`` on the preset's overset pair at Re = V B /
+nu_air with the k-omega SST model (``run_case`` with a ``StaticCase``), averages the body grid's eddy
+viscosity and velocity over the second half of the run (the half the static coefficients use), and along the
+top, at fixed stations from the nose, gives:
+
+- nu_t / nu in the first cell above the top that no forcing touches, and the largest within 0.05 B of it;
+- that cell's speed along the chord (over V) and its distance d to the deck's surface (over B);
+- the eddy viscosity of the law of the wall at that cell, nu (dy+/du+ - 1) on Spalding's profile through the
+  cell's speed and distance (kappa u_tau d in the log layer), and the cell's share of it.
+
+A layer in equilibrium with the wall law has a share near 1; a laminar one near 0.  The body grid rotates
+with the deck, so its rows run along the chord and the deck's polygon is fixed in it.  Writes ``layer.json``
+and ``layer.png`` (the two eddy viscosities along the top) to ``--out``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from plate_loading import _FieldAverage, _say  # noqa: E402
+from reynolds_study import NU_AIR  # noqa: E402
+from validate_turbulence import KAPPA, spalding_uplus_from_re  # noqa: E402
+
+from bridge.aero.forced_motion import QUALITY, SST_WALLS, StaticCase, preset, run_case  # noqa: E402
+from bridge.aero.stage import _unit_polygons  # noqa: E402
+from bridge.cfd.grids import GHOST  # noqa: E402
+from bridge.cfd.sections import great_belt_section  # noqa: E402
+from bridge.errors import InputError  # noqa: E402
+from bridge.files import atomic_write_bytes, atomic_write_text, check_output_root  # noqa: E402
+
+STATIONS = (0.1, 0.2, 0.4, 0.6, 0.8, 0.95, 0.97)   # x / B from the nose
+BAND = 0.05                                       # the height above the top searched for the largest nu_t
+
+
+def distance_to_polygon(points: np.ndarray, vertices: np.ndarray) -> np.ndarray:
+    """Shortest distance from each of ``points`` (n, 2) to the closed polygon's edges (``vertices`` (m, 2))."""
+    a, b = vertices, np.roll(vertices, -1, axis=0)
+    ab = b - a
+    rel = points[:, None, :] - a[None, :, :]
+    s = np.clip((rel * ab).sum(-1) / (ab * ab).sum(-1), 0.0, 1.0)
+    return np.linalg.norm(rel - s[..., None] * ab, axis=-1).min(axis=1)
+
+
+def top_of(vertices: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """The polygon's highest boundary point above each x (its top surface; NaN where no edge spans x)."""
+    a, b = vertices, np.roll(vertices, -1, axis=0)
+    out = np.full(x.shape, -np.inf)
+    for (x0, y0), (x1, y1) in zip(a, b, strict=True):
+        if x1 == x0:
+            continue
+        s = (x - x0) / (x1 - x0)
+        inside = (s >= 0) & (s <= 1)
+        out[inside] = np.maximum(out[inside], y0 + s[inside] * (y1 - y0))
+    return np.where(np.isfinite(out), out, np.nan)
+
+
+def first_free_rows(forced: np.ndarray, y_centres: np.ndarray, columns: np.ndarray, top: np.ndarray) -> np.ndarray:
+    """For each of ``columns``, the row of the first cell whose centre lies above ``top`` (the surface's height
+    there) and which has no forced face; ``forced`` (ny, nx) from ``ImmersedBody.forced_cells``."""
+    rows = []
+    for i, t in zip(columns, top, strict=True):
+        above = np.nonzero(y_centres > t)[0]
+        rows.append(above[np.argmax(~forced[above, i])])
+    return np.array(rows)
+
+
+def law_eddy_viscosity(speed: np.ndarray, d: np.ndarray, nu: float) -> np.ndarray:
+    """nu (dy+/du+ - 1) on Spalding's law through points at distance ``d`` moving at ``speed`` along the wall
+    (``kernels.wall_law.wall_law_eddy_viscosity``, here from validate_turbulence's table): kappa u_tau d in
+    the log layer, 0 in the sublayer."""
+    up = spalding_uplus_from_re(np.abs(speed) * d / nu)
+    z = KAPPA * up
+    slope = 1.0 + math.exp(-KAPPA * 5.0) * KAPPA * (np.exp(z) - 1.0 - z - z * z / 2.0)
+    return nu * (slope - 1.0)
+
+
+def deck_layer(q, angle_deg: float, threads: int | None) -> dict:
+    """The deck held at ``angle_deg`` on ``q`` (an overset SST preset); the layer over its top (module doc)."""
+    polys = _unit_polygons(great_belt_section())
+    average = _FieldAverage(0.5 * q.static_duration)
+    rec = run_case(polys, StaticCase(angle_deg), q, progress=_say, label=f"deck at {angle_deg:g} deg",
+                   threads=threads, observe=average)
+    flow = average.flow
+    grid = flow.body.grid
+    inner = (slice(GHOST, GHOST + grid.ny), slice(GHOST, GHOST + grid.nx))
+    nu = 1.0 / q.reynolds
+    nut = average.mean("nu")[inner] - nu
+    u_faces = average.mean("u")[GHOST:GHOST + grid.ny, GHOST:GHOST + grid.nx + 1]
+    u = 0.5 * (u_faces[:, :-1] + u_faces[:, 1:])
+    forced = np.zeros((grid.ny, grid.nx), dtype=bool)
+    for body in flow.body.bodies:
+        forced |= body.forced_cells()
+    vertices = np.concatenate([p.vertices for p in polys])
+    columns = np.nonzero(np.abs(grid.x_centres) < 0.5)[0]
+    x = grid.x_centres[columns]
+    top = top_of(polys[0].vertices, x)
+    up = first_free_rows(forced, grid.y_centres, columns, top)
+    yc = grid.y_centres[up]
+    d = distance_to_polygon(np.column_stack([x, yc]), vertices)
+    band = grid.y_centres[:, None] < top[None, :] + BAND
+    above = grid.y_centres[:, None] > top[None, :]
+    nut_cols = nut[:, columns] / nu
+    largest = np.where(band & above, nut_cols, -np.inf).max(axis=0)
+    speed = u[up, columns]
+    law = law_eddy_viscosity(speed, d, nu)
+    first = nut[up, columns]
+    return {"x_from_nose": (x + 0.5).tolist(), "first_cell_nut_over_nu": (first / nu).tolist(),
+            "largest_nut_over_nu": largest.tolist(), "first_cell_u": speed.tolist(),
+            "first_cell_distance": d.tolist(), "law_nut_over_nu": (law / nu).tolist(),
+            "share_of_law": np.where(law > 0, first / np.where(law > 0, law, 1.0), np.nan).tolist(),
+            "cells": rec.meta["cells"], "grids": rec.meta["grids"], "wall_s": rec.wall_s, "steps": rec.steps}
+
+
+def _plot(path: Path, got: dict) -> None:
+    import io
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7, 4))
+    x = np.array(got["x_from_nose"])
+    ax.semilogy(x, np.maximum(got["first_cell_nut_over_nu"], 1e-3), ".-", ms=3, lw=1, label="first free cell")
+    ax.semilogy(x, np.maximum(got["largest_nut_over_nu"], 1e-3), ".-", ms=3, lw=1,
+                label=f"largest within {BAND:g} B")
+    ax.semilogy(x, np.maximum(got["law_nut_over_nu"], 1e-3), "k--", lw=1,
+                label="law of the wall at the first free cell")
+    ax.set_xlabel("x / B from the nose")
+    ax.set_ylabel("nu_t / nu above the top")
+    ax.grid(alpha=0.3)
+    ax.legend()
+    fig.tight_layout()
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=120)
+    plt.close(fig)
+    atomic_write_bytes(path, buf.getvalue())
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--quality", default="quick", choices=sorted(QUALITY), help="aero preset (default quick)")
+    ap.add_argument("--angle", type=float, default=2.0, help="angle of attack, degrees (default 2)")
+    ap.add_argument("--speed", type=float, default=50.0, help="wind speed [m/s]: Re = V B / nu_air (default 50)")
+    ap.add_argument("--sst-walls", choices=[w for w in SST_WALLS if w != "resolved"], default="equilibrium",
+                    help="the deck's SST walls (default equilibrium, the aero stage's)")
+    ap.add_argument("--duration", type=float, default=20.0, help="B/V held (default 20); the second half averaged")
+    ap.add_argument("--threads", type=int, default=None, help="threads of the step (default: by grid size)")
+    ap.add_argument("--out", type=Path, default=Path("out/deck_layer"), help="folder (default out/deck_layer)")
+    args = ap.parse_args(argv)
+    for name, value, ok, allowed in (
+            ("--angle", args.angle, abs(args.angle) <= 10.0, "-10 to 10 degrees"),
+            ("--speed", args.speed, args.speed > 0, "> 0"),
+            ("--duration", args.duration, args.duration >= 2.0, ">= 2"),
+            ("--threads", args.threads, args.threads is None or args.threads >= 1, ">= 1")):
+        if not ok:
+            ap.error(f"{name}: {value:g} not allowed; must be {allowed}")
+    section = great_belt_section()
+    try:
+        q = replace(preset(args.quality, "overset"), turbulence="sst", reynolds=args.speed * section.chord_m / NU_AIR,
+                    sst_walls=args.sst_walls, static_duration=args.duration)
+        check_output_root(args.out)
+    except (InputError, ValueError) as err:
+        ap.error(str(err))
+    got = deck_layer(q, args.angle, args.threads)
+    result = {"angle_deg": args.angle, "speed_m_s": args.speed, "reynolds": q.reynolds, "quality": args.quality,
+              "cells_per_chord": q.cells_per_chord, "sst_walls": args.sst_walls, "duration": args.duration, **got}
+    print(f"deck at {args.angle:g} deg, Re {q.reynolds:.3g}, {args.quality} ({q.cells_per_chord} cells per chord), "
+          f"SST walls {args.sst_walls}; second half of {args.duration:g} B/V")
+    print("  x/B   first free cell nu_t/nu   largest within 0.05 B   u/V     d/B      law's nu_t/nu   share")
+    x = np.array(got["x_from_nose"])
+    for i in sorted({int(np.argmin(np.abs(x - x0))) for x0 in STATIONS}):   # a coarse grid may merge stations
+        print(f"  {x[i]:4.2f}   {got['first_cell_nut_over_nu'][i]:22.3g}   {got['largest_nut_over_nu'][i]:21.3g}"
+              f"   {got['first_cell_u'][i]:+.3f}  {got['first_cell_distance'][i]:.4f}   "
+              f"{got['law_nut_over_nu'][i]:14.3g}   {got['share_of_law'][i]:.2g}")
+    atomic_write_text(args.out / "layer.json", json.dumps(result, indent=1))
+    _plot(args.out / "layer.png", got)
+    print(f"wrote {args.out / 'layer.json'} and {args.out / 'layer.png'}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
