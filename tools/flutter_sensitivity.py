@@ -14,7 +14,7 @@ one derivative scaled at every reduced frequency, all others unchanged
 (:func:`bridge.flutter.derivatives.scale_derivative`).  It prints V_c and f_c of the governing pair for
 each derivative and factor, and the elasticity d ln V_c / d ln X from the factors nearest 1;
 ``--together`` scales several derivatives at once (a set of differences seen elsewhere, e.g. between two
-codes) and gives that V_c too.  The lateral
+codes; a factor may be negative, for a derivative whose sign differs) and gives that V_c too.  The lateral
 modes and the multimode p-k are left out (the flutter stage's report gives them for the unscaled model).
 
 Writes ``--out`` (default out/flutter_sensitivity/<scenario>.json).
@@ -112,7 +112,8 @@ def main(argv=None) -> int:
     ap.add_argument("--factors", nargs="+", type=float, default=[0.5, 0.8, 1.25, 1.5],
                     help="factors applied to each, one at a time (default 0.5 0.8 1.25 1.5)")
     ap.add_argument("--together", nargs="+", default=[], metavar="NAME=FACTOR",
-                    help="also scale these derivatives all at once (e.g. H3=1.1 A2=1.5)")
+                    help="also scale these derivatives all at once (e.g. H3=1.1 A2=1.5; a negative factor turns "
+                         "a derivative's sign, as H2* of a deck may between grids or codes)")
     ap.add_argument("--quality", choices=("tiny", "quick", "standard", "fine"), default=None,
                     help="the aero stage's CFD preset, for scenarios with CFD aerodynamics (default the "
                          "scenario's)")
@@ -135,9 +136,9 @@ def main(argv=None) -> int:
             factor = float(value)
         except ValueError:
             factor = math.nan
-        if name not in VERTICAL_TORSIONAL or not (math.isfinite(factor) and 0.0 <= factor <= 10.0):
+        if name not in VERTICAL_TORSIONAL or not (math.isfinite(factor) and -10.0 <= factor <= 10.0):
             ap.error(f"--together: {item!r} must be NAME=FACTOR with NAME one of {', '.join(VERTICAL_TORSIONAL)} "
-                     "and FACTOR in [0, 10]")
+                     "and FACTOR in [-10, 10]")
         together[name] = factor
     args.together = together
     try:

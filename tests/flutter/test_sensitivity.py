@@ -69,7 +69,8 @@ def test_all_eight_derivatives_times_f_flutter_as_the_air_density_times_f(tmp_pa
 
 
 @pytest.mark.parametrize("args, field", [(["--factors", "1"], "--factors"), (["--derivatives", "P1"], "--derivatives"),
-                                         (["--together", "A2=x"], "--together")])
+                                         (["--together", "A2=x"], "--together"),
+                                         (["--together", "A2=-11"], "--together")])
 def test_bad_input_names_the_option_and_writes_nothing(tmp_path, capsys, args, field):
     tool = load_tool("flutter_sensitivity")
     with pytest.raises(SystemExit) as exc:
@@ -77,3 +78,22 @@ def test_bad_input_names_the_option_and_writes_nothing(tmp_path, capsys, args, f
     assert exc.value.code == 2
     assert field in capsys.readouterr().err
     assert not (tmp_path / "s.json").exists()
+
+
+def test_together_takes_a_negative_factor_a_derivative_whose_sign_differs(tmp_path):
+    """H2* of a deck may change sign between grids (docs/aero.md); the plate's V_c with H2* x -1 is the
+    flutter solver's with that model."""
+    tool = load_tool("flutter_sensitivity")
+    out = tmp_path / "s.json"
+    assert tool.main(["thin_plate_section", "--derivatives", "A2", "--factors", "1.25", "--cache",
+                      str(tmp_path / "cache"), "--out", str(out), "--together", "H2=-1"]) == 0
+    result = json.loads(out.read_text())
+    assert result["together"]["factors"] == {"H2": -1.0}
+    sc = load_scenario("thin_plate_section")
+    modal, fopts = sc.section.modal_model(), sc.flutter
+    gov = governing([solve_pair(modal.subset(p), tool.Scaled(Theodorsen(), "H2", -1.0), 1.225, fopts.max_speed_m_s,
+                                min_speed_m_s=fopts.min_speed_m_s, n_speed=fopts.speed_steps)
+                     for p in modal.pairs(fopts.pairs)])
+    assert result["together"]["critical_speed_m_s"] == pytest.approx(gov.critical_speed_m_s, rel=1e-8)
+    assert result["together"]["critical_speed_m_s"] != pytest.approx(result["unscaled"]["critical_speed_m_s"],
+                                                                    rel=1e-3)
