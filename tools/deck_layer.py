@@ -13,7 +13,8 @@ viscosity and velocity over the second half of the run (the half the static coef
 top, at fixed stations from the nose, gives:
 
 - nu_t / nu in the first cell above the top that no forcing touches, and the largest within 0.05 B of it;
-- that cell's speed along the chord (over V) and its distance d to the deck's surface (over B);
+- that cell's speed along the chord (over V) and its distance d to the deck's surface (over B), and the speed
+  at 0.01, 0.02, 0.05 and 0.1 B above the top (interpolated in the column): how thick the layer is;
 - the eddy viscosity of the law of the wall at that cell, nu (dy+/du+ - 1) on Spalding's profile through the
   cell's speed and distance (kappa u_tau d in the log layer), and the cell's share of it.
 
@@ -48,6 +49,7 @@ from bridge.errors import InputError  # noqa: E402
 from bridge.files import atomic_write_bytes, atomic_write_text, check_output_root  # noqa: E402
 
 STATIONS = (0.1, 0.2, 0.4, 0.6, 0.8, 0.95, 0.97)   # x / B from the nose
+HEIGHTS = (0.01, 0.02, 0.05, 0.1)                 # above the top, B: the speed profile through the layer
 BAND = 0.05                                       # the height above the top searched for the largest nu_t
 
 
@@ -121,10 +123,13 @@ def deck_layer(q, angle_deg: float, threads: int | None) -> dict:
     nut_cols = nut[:, columns] / nu
     largest = np.where(band & above, nut_cols, -np.inf).max(axis=0)
     speed = u[up, columns]
+    profile = [[float(np.interp(t + h, grid.y_centres, u[:, i])) for h in HEIGHTS] for i, t in zip(columns, top,
+                                                                                                   strict=True)]
     law = law_eddy_viscosity(speed, d, nu)
     first = nut[up, columns]
     return {"x_from_nose": (x + 0.5).tolist(), "first_cell_nut_over_nu": (first / nu).tolist(),
             "largest_nut_over_nu": largest.tolist(), "first_cell_u": speed.tolist(),
+            "heights": list(HEIGHTS), "u_at_heights": profile,
             "first_cell_distance": d.tolist(), "law_nut_over_nu": (law / nu).tolist(),
             "share_of_law": np.where(law > 0, first / np.where(law > 0, law, 1.0), np.nan).tolist(),
             "cells": rec.meta["cells"], "grids": rec.meta["grids"], "wall_s": rec.wall_s, "steps": rec.steps}
@@ -186,12 +191,14 @@ def main(argv=None) -> int:
               "cells_per_chord": q.cells_per_chord, "sst_walls": args.sst_walls, "duration": args.duration, **got}
     print(f"deck at {args.angle:g} deg, Re {q.reynolds:.3g}, {args.quality} ({q.cells_per_chord} cells per chord), "
           f"SST walls {args.sst_walls}; second half of {args.duration:g} B/V")
-    print("  x/B   first free cell nu_t/nu   largest within 0.05 B   u/V     d/B      law's nu_t/nu   share")
+    print("  x/B   first free cell nu_t/nu   largest within 0.05 B   u/V     d/B      law's nu_t/nu   share   "
+          "u/V at " + " / ".join(f"{h:g}" for h in HEIGHTS) + " B above the top")
     x = np.array(got["x_from_nose"])
     for i in sorted({int(np.argmin(np.abs(x - x0))) for x0 in STATIONS}):   # a coarse grid may merge stations
         print(f"  {x[i]:4.2f}   {got['first_cell_nut_over_nu'][i]:22.3g}   {got['largest_nut_over_nu'][i]:21.3g}"
               f"   {got['first_cell_u'][i]:+.3f}  {got['first_cell_distance'][i]:.4f}   "
-              f"{got['law_nut_over_nu'][i]:14.3g}   {got['share_of_law'][i]:.2g}")
+              f"{got['law_nut_over_nu'][i]:14.3g}   {got['share_of_law'][i]:5.2g}   "
+              + " / ".join(f"{v:.3f}" for v in got["u_at_heights"][i]))
     atomic_write_text(args.out / "layer.json", json.dumps(result, indent=1))
     _plot(args.out / "layer.png", got)
     print(f"wrote {args.out / 'layer.json'} and {args.out / 'layer.png'}")

@@ -70,6 +70,9 @@ def test_a_short_run_reads_the_layer_over_the_top(tmp_path):
     assert min(got["first_cell_distance"]) > 0 and max(got["first_cell_distance"]) < 0.1
     assert min(got["first_cell_nut_over_nu"]) > -1e-6
     assert np.all(np.array(got["largest_nut_over_nu"]) >= np.array(got["first_cell_nut_over_nu"]) - 1e-9)
+    profile = np.array(got["u_at_heights"])
+    assert profile.shape == (len(x), len(got["heights"])) and np.isfinite(profile).all()
+    assert profile[:, -1].min() > 0.5          # 0.1 B above the top: outside the layer after 2 B/V
 
 
 @pytest.mark.slow
