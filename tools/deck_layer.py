@@ -111,13 +111,12 @@ def deck_layer(q, angle_deg: float, threads: int | None) -> dict:
     forced = np.zeros((grid.ny, grid.nx), dtype=bool)
     for body in flow.body.bodies:
         forced |= body.forced_cells()
-    vertices = np.concatenate([p.vertices for p in polys])
     columns = np.nonzero(np.abs(grid.x_centres) < 0.5)[0]
     x = grid.x_centres[columns]
     top = top_of(polys[0].vertices, x)
     up = first_free_rows(forced, grid.y_centres, columns, top)
     yc = grid.y_centres[up]
-    d = distance_to_polygon(np.column_stack([x, yc]), vertices)
+    d = np.min([distance_to_polygon(np.column_stack([x, yc]), p.vertices) for p in polys], axis=0)
     band = grid.y_centres[:, None] < top[None, :] + BAND
     above = grid.y_centres[:, None] > top[None, :]
     nut_cols = nut[:, columns] / nu
@@ -131,8 +130,12 @@ def deck_layer(q, angle_deg: float, threads: int | None) -> dict:
             "largest_nut_over_nu": largest.tolist(), "first_cell_u": speed.tolist(),
             "heights": list(HEIGHTS), "u_at_heights": profile,
             "first_cell_distance": d.tolist(), "law_nut_over_nu": (law / nu).tolist(),
-            "share_of_law": np.where(law > 0, first / np.where(law > 0, law, 1.0), np.nan).tolist(),
+            "share_of_law": [float(f / w) if w > 0 else None for f, w in zip(first, law, strict=True)],
             "cells": rec.meta["cells"], "grids": rec.meta["grids"], "wall_s": rec.wall_s, "steps": rec.steps}
+
+
+def _share(value: float | None) -> str:
+    return "    -" if value is None else f"{value:5.2g}"
 
 
 def _plot(path: Path, got: dict) -> None:
@@ -197,7 +200,7 @@ def main(argv=None) -> int:
     for i in sorted({int(np.argmin(np.abs(x - x0))) for x0 in STATIONS}):   # a coarse grid may merge stations
         print(f"  {x[i]:4.2f}   {got['first_cell_nut_over_nu'][i]:22.3g}   {got['largest_nut_over_nu'][i]:21.3g}"
               f"   {got['first_cell_u'][i]:+.3f}  {got['first_cell_distance'][i]:.4f}   "
-              f"{got['law_nut_over_nu'][i]:14.3g}   {got['share_of_law'][i]:5.2g}   "
+              f"{got['law_nut_over_nu'][i]:14.3g}   {_share(got['share_of_law'][i])}   "
               + " / ".join(f"{v:.3f}" for v in got["u_at_heights"][i]))
     atomic_write_text(args.out / "layer.json", json.dumps(result, indent=1))
     _plot(args.out / "layer.png", got)

@@ -232,7 +232,7 @@ def ibplate(dy=4e-4, dx=0.01, t_end=2.5, reynolds=5e6, threads=2, progress=None,
                 progress(sim.t, t_end)
     cf, yp = skin_friction()
     friction = 2 * np.trapezoid(np.where(on, cf, 0.0), xu) * 0.5   # both sides, rho U^2 / 2 = 1/2
-    return {"case": f"SST flat plate, immersed, wall function ({body_walls})", "dy": dy, "dx": dx, "nx": grid.nx,
+    return {"case": f"SST flat plate, immersed, walls: {body_walls}", "dy": dy, "dx": dx, "nx": grid.nx,
             "ny": grid.ny,
             "t_end": t_end, "steps": sim.n_steps, "wall_s": time.perf_counter() - t0,
             "cf_0.97": float(np.interp(0.97008, xu, cf)), "band": [0.00271, 0.00272],
