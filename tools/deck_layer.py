@@ -15,6 +15,7 @@ top, at fixed stations from the nose, gives:
 - nu_t / nu in the first cell above the top that no forcing touches, and the largest within 0.05 B of it;
 - that cell's speed along the chord (over V) and its distance d to the deck's surface (over B), and the speed
   at 0.01, 0.02, 0.05 and 0.1 B above the top (interpolated in the column): how thick the layer is;
+- the specific dissipation omega there at the end of the run, over the log layer's u_tau / (sqrt(beta*) kappa d);
 - the eddy viscosity of the law of the wall at that cell, nu (dy+/du+ - 1) on Spalding's profile through the
   cell's speed and distance (kappa u_tau d in the log layer), and the cell's share of it.
 
@@ -126,11 +127,17 @@ def deck_layer(q, angle_deg: float, threads: int | None) -> dict:
                                                                                                    strict=True)]
     law = law_eddy_viscosity(speed, d, nu)
     first = nut[up, columns]
+    # the specific dissipation at the end of the run against the log layer's u_tau / (sqrt(beta*) kappa d),
+    # u_tau from the cell's speed on Spalding's law
+    omega = flow.model.body.omega.q.numpy()[inner][up, columns]
+    u_tau = np.abs(speed) / np.maximum(spalding_uplus_from_re(np.abs(speed) * d / nu), 1e-12)
+    omega_log = u_tau / (math.sqrt(0.09) * KAPPA * d)
     return {"x_from_nose": (x + 0.5).tolist(), "first_cell_nut_over_nu": (first / nu).tolist(),
             "largest_nut_over_nu": largest.tolist(), "first_cell_u": speed.tolist(),
             "heights": list(HEIGHTS), "u_at_heights": profile,
             "first_cell_distance": d.tolist(), "law_nut_over_nu": (law / nu).tolist(),
             "share_of_law": [float(f / w) if w > 0 else None for f, w in zip(first, law, strict=True)],
+            "first_cell_omega_over_log": (omega / omega_log).tolist(),
             "cells": rec.meta["cells"], "grids": rec.meta["grids"], "wall_s": rec.wall_s, "steps": rec.steps}
 
 
@@ -195,13 +202,14 @@ def main(argv=None) -> int:
     print(f"deck at {args.angle:g} deg, Re {q.reynolds:.3g}, {args.quality} ({q.cells_per_chord} cells per chord), "
           f"SST walls {args.sst_walls}; second half of {args.duration:g} B/V")
     print("  x/B   first free cell nu_t/nu   largest within 0.05 B   u/V     d/B      law's nu_t/nu   share   "
-          "u/V at " + " / ".join(f"{h:g}" for h in HEIGHTS) + " B above the top")
+          "u/V at " + " / ".join(f"{h:g}" for h in HEIGHTS) + " B above the top   omega/omega_log")
     x = np.array(got["x_from_nose"])
     for i in sorted({int(np.argmin(np.abs(x - x0))) for x0 in STATIONS}):   # a coarse grid may merge stations
         print(f"  {x[i]:4.2f}   {got['first_cell_nut_over_nu'][i]:22.3g}   {got['largest_nut_over_nu'][i]:21.3g}"
               f"   {got['first_cell_u'][i]:+.3f}  {got['first_cell_distance'][i]:.4f}   "
               f"{got['law_nut_over_nu'][i]:14.3g}   {_share(got['share_of_law'][i])}   "
-              + " / ".join(f"{v:.3f}" for v in got["u_at_heights"][i]))
+              + " / ".join(f"{v:.3f}" for v in got["u_at_heights"][i])
+              + f"   {got['first_cell_omega_over_log'][i]:.3g}")
     atomic_write_text(args.out / "layer.json", json.dumps(result, indent=1))
     _plot(args.out / "layer.png", got)
     print(f"wrote {args.out / 'layer.json'} and {args.out / 'layer.png'}")

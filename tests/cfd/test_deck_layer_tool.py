@@ -73,6 +73,8 @@ def test_a_short_run_reads_the_layer_over_the_top(tmp_path):
     profile = np.array(got["u_at_heights"])
     assert profile.shape == (len(x), len(got["heights"])) and np.isfinite(profile).all()
     assert profile[:, -1].min() > 0.5          # 0.1 B above the top: outside the layer after 2 B/V
+    ratio = np.array(got["first_cell_omega_over_log"])
+    assert ratio.shape == x.shape and np.isfinite(ratio).all() and ratio.min() > 0
 
 
 @pytest.mark.slow
