@@ -38,16 +38,17 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from plate_loading import _FieldAverage, _say  # noqa: E402
+from plate_loading import _FieldAverage, _say, save_png  # noqa: E402
 from reynolds_study import NU_AIR  # noqa: E402
 from validate_turbulence import KAPPA, spalding_uplus_from_re  # noqa: E402
+from validate_turbulence import B as B_LOG  # noqa: E402
 
 from bridge.aero.forced_motion import QUALITY, SST_WALLS, StaticCase, preset, run_case  # noqa: E402
 from bridge.aero.stage import _unit_polygons  # noqa: E402
 from bridge.cfd.grids import GHOST  # noqa: E402
 from bridge.cfd.sections import great_belt_section  # noqa: E402
 from bridge.errors import InputError  # noqa: E402
-from bridge.files import atomic_write_bytes, atomic_write_text, check_output_root  # noqa: E402
+from bridge.files import atomic_write_text, check_output_root  # noqa: E402
 
 STATIONS = (0.1, 0.2, 0.4, 0.6, 0.8, 0.95, 0.97)   # x / B from the nose
 HEIGHTS = (0.01, 0.02, 0.05, 0.1)                 # above the top, B: the speed profile through the layer
@@ -92,7 +93,7 @@ def law_eddy_viscosity(speed: np.ndarray, d: np.ndarray, nu: float) -> np.ndarra
     the log layer, 0 in the sublayer."""
     up = spalding_uplus_from_re(np.abs(speed) * d / nu)
     z = KAPPA * up
-    slope = 1.0 + math.exp(-KAPPA * 5.0) * KAPPA * (np.exp(z) - 1.0 - z - z * z / 2.0)
+    slope = 1.0 + math.exp(-KAPPA * B_LOG) * KAPPA * (np.exp(z) - 1.0 - z - z * z / 2.0)
     return nu * (slope - 1.0)
 
 
@@ -146,8 +147,6 @@ def _share(value: float | None) -> str:
 
 
 def _plot(path: Path, got: dict) -> None:
-    import io
-
     import matplotlib
 
     matplotlib.use("Agg")
@@ -165,10 +164,7 @@ def _plot(path: Path, got: dict) -> None:
     ax.grid(alpha=0.3)
     ax.legend()
     fig.tight_layout()
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=120)
-    plt.close(fig)
-    atomic_write_bytes(path, buf.getvalue())
+    save_png(path, fig)
 
 
 def main(argv=None) -> int:

@@ -151,8 +151,6 @@ def _listed(side: dict) -> dict:
 
 
 def _plot(path: Path, curves: list[tuple[str, np.ndarray, np.ndarray]], alpha: float, sides: list) -> None:
-    import io
-
     import matplotlib
 
     matplotlib.use("Agg")
@@ -174,6 +172,15 @@ def _plot(path: Path, curves: list[tuple[str, np.ndarray, np.ndarray]], alpha: f
     bx.grid(alpha=0.3)
     bx.legend()
     fig.tight_layout()
+    save_png(path, fig)
+
+
+def save_png(path: Path, fig) -> None:
+    """Write ``fig`` to ``path`` as PNG (whole or not at all) and close it."""
+    import io
+
+    import matplotlib.pyplot as plt
+
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=120)
     plt.close(fig)
