@@ -1,16 +1,16 @@
-"""The Great Belt deck's boundary layer over its top: laminar, turbulent, or short of the log layer
-(docs/aero.md, "The deck's own boundary layer" and "A layer turbulent from the nose").
+"""The Great Belt deck's boundary layers over its top and under its bottom: laminar, turbulent, short of the
+log layer, or reversed (docs/aero.md, "The deck's own boundary layer" and "A layer turbulent from the nose").
 
-    python tools/deck_layer.py [--quality quick] [--angle 2] [--speed 50]
-                               [--sst-walls equilibrium|function|blended] [--duration 20] [--threads N]
-                               [--out out/deck_layer]
+    python tools/deck_layer.py [--section great_belt|plate] [--nose-height F] [--quality quick] [--angle 2]
+                               [--speed 50] [--sst-walls equilibrium|function|blended] [--duration 20]
+                               [--threads N] [--out out/deck_layer]
 
 Why: the SST deck's wall treatment decides whether its layer is turbulent from the nose, as it is at the
 deck's Reynolds number (1e8), and the wall function's velocity profile assumes that it is.  This tool holds
 the deck (``bridge.cfd.sections.great_belt_section``) at ``--angle`` on the preset's overset pair at Re = V B /
 nu_air with the k-omega SST model (``run_case`` with a ``StaticCase``), averages the body grid's eddy
-viscosity and velocity over the second half of the run (the half the static coefficients use), and along the
-top, at fixed stations from the nose, gives:
+viscosity and velocity over the second half of the run (the half the static coefficients use), and gives the
+mean lift, drag and moment coefficients over that half and, along the top, at fixed stations from the nose:
 
 - nu_t / nu in the first cell above the top that no forcing touches, and the largest within 0.05 B of it;
 - that cell's speed along the chord (over V) and its distance d to the deck's surface (over B), and the speed
@@ -19,9 +19,16 @@ top, at fixed stations from the nose, gives:
 - the eddy viscosity of the law of the wall at that cell, nu (dy+/du+ - 1) on Spalding's profile through the
   cell's speed and distance (kappa u_tau d in the log layer), and the cell's share of it.
 
-A layer in equilibrium with the wall law has a share near 1; a laminar one near 0.  The body grid rotates
-with the deck, so its rows run along the chord and the deck's polygon is fixed in it.  Writes ``layer.json``
-and ``layer.png`` (the two eddy viscosities along the top) to ``--out``.
+The same under the bottom (the section seen from beneath), where the layer runs into the rising rear panel.
+A layer in equilibrium with the wall law has a share near 1; a laminar one near 0.
+
+``--section plate`` runs the control instead: a flat plate 2 % of the chord thick, of the deck's chord and
+Reynolds number, best held at zero incidence, whose turbulent layer has a textbook thickness (delta / x = 0.37
+Re_x^(-1/5): under 0.01 of the chord), so that what the grid and the wall treatment add to a layer shows apart
+from the deck's shape.  ``--nose-height 1`` moves the deck's nose up onto the roof line (no fairing panel, no
+corner over the top).  The body grid rotates with the deck, so its rows run along the chord and the deck's
+polygon is fixed in it.  Writes ``layer.json`` and ``layer.png`` (the two eddy viscosities along the top; the
+first free cells' speed over the top and under the bottom, where a reversed layer shows) to ``--out``.
 """
 
 from __future__ import annotations
@@ -44,14 +51,15 @@ from validate_turbulence import KAPPA, spalding_uplus_from_re  # noqa: E402
 from validate_turbulence import B as B_LOG  # noqa: E402
 
 from bridge.aero.forced_motion import QUALITY, SST_WALLS, StaticCase, preset, run_case  # noqa: E402
-from bridge.aero.stage import _unit_polygons  # noqa: E402
+from bridge.aero.stage import _unit_polygon, _unit_polygons  # noqa: E402
 from bridge.cfd.grids import GHOST  # noqa: E402
-from bridge.cfd.sections import great_belt_section  # noqa: E402
+from bridge.cfd.sections import FlatPlate, great_belt_section  # noqa: E402
 from bridge.errors import InputError  # noqa: E402
 from bridge.files import atomic_write_text, check_output_root  # noqa: E402
 
 STATIONS = (0.1, 0.2, 0.4, 0.6, 0.8, 0.95, 0.97)   # x / B from the nose
 HEIGHTS = (0.01, 0.02, 0.05, 0.1)                 # above the top, B: the speed profile through the layer
+PLATE_THICKNESS = 0.02                            # of the chord, --section plate
 BAND = 0.05                                       # the height above the top searched for the largest nu_t
 
 
@@ -97,40 +105,72 @@ def law_eddy_viscosity(speed: np.ndarray, d: np.ndarray, nu: float) -> np.ndarra
     return nu * (slope - 1.0)
 
 
-def deck_layer(q, angle_deg: float, threads: int | None) -> dict:
-    """The deck held at ``angle_deg`` on ``q`` (an overset SST preset); the layer over its top (module doc)."""
-    polys = _unit_polygons(great_belt_section())
+SECTIONS = ("great_belt", "plate")
+
+
+def section_polygons(name: str, nose_height: float | None = None) -> list:
+    """The unit-chord polygons of ``name``: the Great Belt deck, or a flat plate ``PLATE_THICKNESS`` of the
+    chord thick (``bridge.cfd.sections.FlatPlate``, square ends, as tools/plate_loading.py's): the control,
+    whose layer at zero incidence has a textbook thickness.  ``nose_height``: the deck's
+    ``StreamlinedBox.nose_height_fraction`` instead of its default (1 puts the nose on the roof line: no
+    fairing panel, no corner over the top)."""
+    if name == "plate":
+        return [_unit_polygon(FlatPlate(1.0, PLATE_THICKNESS))]
+    deck = great_belt_section()
+    if nose_height is not None:
+        deck = replace(deck, nose_height_fraction=nose_height)
+    return _unit_polygons(deck)
+
+
+def deck_layer(q, angle_deg: float, threads: int | None, polys: list, section: str = "great_belt") -> dict:
+    """The section ``polys`` (unit chord, ``section`` names it in the progress) held at ``angle_deg`` on ``q``
+    (an overset SST preset); the layer over its top (module doc), and under its bottom as ``"bottom"``."""
     average = _FieldAverage(0.5 * q.static_duration)
-    rec = run_case(polys, StaticCase(angle_deg), q, progress=_say, label=f"deck at {angle_deg:g} deg",
+    rec = run_case(polys, StaticCase(angle_deg), q, progress=_say, label=f"{section} at {angle_deg:g} deg",
                    threads=threads, observe=average)
     flow = average.flow
     grid = flow.body.grid
     inner = (slice(GHOST, GHOST + grid.ny), slice(GHOST, GHOST + grid.nx))
-    nu = 1.0 / q.reynolds
-    nut = average.mean("nu")[inner] - nu
     u_faces = average.mean("u")[GHOST:GHOST + grid.ny, GHOST:GHOST + grid.nx + 1]
-    u = 0.5 * (u_faces[:, :-1] + u_faces[:, 1:])
     forced = np.zeros((grid.ny, grid.nx), dtype=bool)
     for body in flow.body.bodies:
         forced |= body.forced_cells()
-    columns = np.nonzero(np.abs(grid.x_centres) < 0.5)[0]
-    x = grid.x_centres[columns]
-    top = top_of(polys[0].vertices, x)
-    up = first_free_rows(forced, grid.y_centres, columns, top)
-    yc = grid.y_centres[up]
-    d = np.min([distance_to_polygon(np.column_stack([x, yc]), p.vertices) for p in polys], axis=0)
-    band = grid.y_centres[:, None] < top[None, :] + BAND
-    above = grid.y_centres[:, None] > top[None, :]
+    fields = {"nut": average.mean("nu")[inner] - 1.0 / q.reynolds, "u": 0.5 * (u_faces[:, :-1] + u_faces[:, 1:]),
+              "forced": forced, "omega": flow.model.body.omega.q.numpy()[inner]}
+    # the side below, seen from beneath: the rows and the heights mirrored, the chordwise speed unchanged
+    below = {name: a[::-1] for name, a in fields.items()}
+    mirrored = [p.vertices * np.array([1.0, -1.0]) for p in polys]
+    second = rec.t > 0.5 * q.static_duration   # per rho V^2 B (B^2): twice the coefficients
+    forces = {name: float(2.0 * getattr(rec, force)[second].mean())
+              for name, force in (("C_L", "lift"), ("C_D", "drag"), ("C_M", "moment"))}
+    return {**forces, **layer_along(fields, grid.y_centres, grid.x_centres, [p.vertices for p in polys], q.reynolds),
+            "bottom": layer_along(below, -grid.y_centres[::-1], grid.x_centres, mirrored, q.reynolds),
+            "cells": rec.meta["cells"], "grids": rec.meta["grids"], "wall_s": rec.wall_s, "steps": rec.steps}
+
+
+def layer_along(fields: dict, y_centres: np.ndarray, x_centres: np.ndarray, outlines: list, reynolds: float) -> dict:
+    """The layer over the top of ``outlines`` (unit chord, the first the section's body) from the body grid's
+    time-averaged ``fields`` (ny, nx: "nut", "u" at the cell centres, "forced", "omega"); module doc."""
+    nu = 1.0 / reynolds
+    nut, u = fields["nut"], fields["u"]
+    columns = np.nonzero(np.abs(x_centres) < 0.5)[0]
+    x = x_centres[columns]
+    top = top_of(outlines[0], x)
+    up = first_free_rows(fields["forced"], y_centres, columns, top)
+    yc = y_centres[up]
+    d = np.min([distance_to_polygon(np.column_stack([x, yc]), v) for v in outlines], axis=0)
+    band = y_centres[:, None] < top[None, :] + BAND
+    above = y_centres[:, None] > top[None, :]
     nut_cols = nut[:, columns] / nu
     largest = np.where(band & above, nut_cols, -np.inf).max(axis=0)
     speed = u[up, columns]
-    profile = [[float(np.interp(t + h, grid.y_centres, u[:, i])) for h in HEIGHTS] for i, t in zip(columns, top,
-                                                                                                   strict=True)]
+    profile = [[float(np.interp(t + h, y_centres, u[:, i])) for h in HEIGHTS] for i, t in zip(columns, top,
+                                                                                              strict=True)]
     law = law_eddy_viscosity(speed, d, nu)
     first = nut[up, columns]
     # the specific dissipation at the end of the run against the log layer's u_tau / (sqrt(beta*) kappa d),
     # u_tau from the cell's speed on Spalding's law
-    omega = flow.model.body.omega.q.numpy()[inner][up, columns]
+    omega = fields["omega"][up, columns]
     u_tau = np.abs(speed) / np.maximum(spalding_uplus_from_re(np.abs(speed) * d / nu), 1e-12)
     omega_log = u_tau / (math.sqrt(0.09) * KAPPA * d)
     return {"x_from_nose": (x + 0.5).tolist(), "first_cell_nut_over_nu": (first / nu).tolist(),
@@ -138,8 +178,17 @@ def deck_layer(q, angle_deg: float, threads: int | None) -> dict:
             "heights": list(HEIGHTS), "u_at_heights": profile,
             "first_cell_distance": d.tolist(), "law_nut_over_nu": (law / nu).tolist(),
             "share_of_law": [float(f / w) if w > 0 else None for f, w in zip(first, law, strict=True)],
-            "first_cell_omega_over_log": (omega / omega_log).tolist(),
-            "cells": rec.meta["cells"], "grids": rec.meta["grids"], "wall_s": rec.wall_s, "steps": rec.steps}
+            "first_cell_omega_over_log": (omega / omega_log).tolist()}
+
+
+def _table(got: dict) -> None:
+    x = np.array(got["x_from_nose"])
+    for i in sorted({int(np.argmin(np.abs(x - x0))) for x0 in STATIONS}):   # a coarse grid may merge stations
+        print(f"  {x[i]:4.2f}   {got['first_cell_nut_over_nu'][i]:22.3g}   {got['largest_nut_over_nu'][i]:21.3g}"
+              f"   {got['first_cell_u'][i]:+.3f}  {got['first_cell_distance'][i]:.4f}   "
+              f"{got['law_nut_over_nu'][i]:14.3g}   {_share(got['share_of_law'][i])}   "
+              + " / ".join(f"{v:.3f}" for v in got["u_at_heights"][i])
+              + f"   {got['first_cell_omega_over_log'][i]:.3g}")
 
 
 def _share(value: float | None) -> str:
@@ -152,7 +201,7 @@ def _plot(path: Path, got: dict) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(7, 4))
+    fig, (ax, bx) = plt.subplots(1, 2, figsize=(11, 4))
     x = np.array(got["x_from_nose"])
     ax.semilogy(x, np.maximum(got["first_cell_nut_over_nu"], 1e-3), ".-", ms=3, lw=1, label="first free cell")
     ax.semilogy(x, np.maximum(got["largest_nut_over_nu"], 1e-3), ".-", ms=3, lw=1,
@@ -163,6 +212,13 @@ def _plot(path: Path, got: dict) -> None:
     ax.set_ylabel("nu_t / nu above the top")
     ax.grid(alpha=0.3)
     ax.legend()
+    for side, values, style in (("top", got, ".-"), ("bottom", got["bottom"], "x--")):
+        bx.plot(values["x_from_nose"], values["first_cell_u"], style, ms=3, lw=1, label=f"{side}: first free cell")
+    bx.axhline(0.0, color="k", lw=0.5)
+    bx.set_xlabel("x / B from the nose")
+    bx.set_ylabel("u / V along the chord (below 0: reversed)")
+    bx.grid(alpha=0.3)
+    bx.legend()
     fig.tight_layout()
     save_png(path, fig)
 
@@ -170,6 +226,10 @@ def _plot(path: Path, got: dict) -> None:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--quality", default="quick", choices=sorted(QUALITY), help="aero preset (default quick)")
+    ap.add_argument("--section", choices=SECTIONS, default="great_belt",
+                    help="the Great Belt deck (default) or a flat plate 2 %% of the chord thick (the control)")
+    ap.add_argument("--nose-height", type=float, default=None,
+                    help="the deck's nose_height_fraction (default the section's 0.8; 1: no corner over the top)")
     ap.add_argument("--angle", type=float, default=2.0, help="angle of attack, degrees (default 2)")
     ap.add_argument("--speed", type=float, default=50.0, help="wind speed [m/s]: Re = V B / nu_air (default 50)")
     ap.add_argument("--sst-walls", choices=[w for w in SST_WALLS if w != "resolved"], default="equilibrium",
@@ -182,30 +242,32 @@ def main(argv=None) -> int:
             ("--angle", args.angle, abs(args.angle) <= 10.0, "-10 to 10 degrees"),
             ("--speed", args.speed, args.speed > 0, "> 0"),
             ("--duration", args.duration, args.duration >= 2.0, ">= 2"),
-            ("--threads", args.threads, args.threads is None or args.threads >= 1, ">= 1")):
+            ("--threads", args.threads, args.threads is None or args.threads >= 1, ">= 1"),
+            ("--nose-height", args.nose_height, args.nose_height is None or 0.0 < args.nose_height <= 1.0, "(0, 1]")):
         if not ok:
             ap.error(f"{name}: {value:g} not allowed; must be {allowed}")
     section = great_belt_section()
     try:
         q = replace(preset(args.quality, "overset"), turbulence="sst", reynolds=args.speed * section.chord_m / NU_AIR,
                     sst_walls=args.sst_walls, static_duration=args.duration)
+        if args.nose_height is not None and args.section != "great_belt":
+            raise InputError("--nose-height", args.nose_height, "applies to --section great_belt only")
+        polys = section_polygons(args.section, args.nose_height)
         check_output_root(args.out)
     except (InputError, ValueError) as err:
         ap.error(str(err))
-    got = deck_layer(q, args.angle, args.threads)
-    result = {"angle_deg": args.angle, "speed_m_s": args.speed, "reynolds": q.reynolds, "quality": args.quality,
+    got = deck_layer(q, args.angle, args.threads, polys, args.section)
+    result = {"section": args.section, "nose_height_fraction": args.nose_height, "angle_deg": args.angle,
+              "speed_m_s": args.speed, "reynolds": q.reynolds, "quality": args.quality,
               "cells_per_chord": q.cells_per_chord, "sst_walls": args.sst_walls, "duration": args.duration, **got}
-    print(f"deck at {args.angle:g} deg, Re {q.reynolds:.3g}, {args.quality} ({q.cells_per_chord} cells per chord), "
+    print(f"{args.section} at {args.angle:g} deg, Re {q.reynolds:.3g}, {args.quality} "
+          f"({q.cells_per_chord} cells per chord), "
           f"SST walls {args.sst_walls}; second half of {args.duration:g} B/V")
-    print("  x/B   first free cell nu_t/nu   largest within 0.05 B   u/V     d/B      law's nu_t/nu   share   "
-          "u/V at " + " / ".join(f"{h:g}" for h in HEIGHTS) + " B above the top   omega/omega_log")
-    x = np.array(got["x_from_nose"])
-    for i in sorted({int(np.argmin(np.abs(x - x0))) for x0 in STATIONS}):   # a coarse grid may merge stations
-        print(f"  {x[i]:4.2f}   {got['first_cell_nut_over_nu'][i]:22.3g}   {got['largest_nut_over_nu'][i]:21.3g}"
-              f"   {got['first_cell_u'][i]:+.3f}  {got['first_cell_distance'][i]:.4f}   "
-              f"{got['law_nut_over_nu'][i]:14.3g}   {_share(got['share_of_law'][i])}   "
-              + " / ".join(f"{v:.3f}" for v in got["u_at_heights"][i])
-              + f"   {got['first_cell_omega_over_log'][i]:.3g}")
+    print("  C_L {C_L:+.4f}   C_D {C_D:.4f}   C_M {C_M:+.4f}   (means over the second half)".format(**got))
+    for side, beyond, values in (("top", "above the top", got), ("bottom", "below the bottom", got["bottom"])):
+        print(f"{side}:\n  x/B   first free cell nu_t/nu   largest within {BAND:g} B   u/V     d/B      law's nu_t/nu"
+              "   share   u/V at " + " / ".join(f"{h:g}" for h in HEIGHTS) + f" B {beyond}   omega/omega_log")
+        _table(values)
     atomic_write_text(args.out / "layer.json", json.dumps(result, indent=1))
     _plot(args.out / "layer.png", got)
     print(f"wrote {args.out / 'layer.json'} and {args.out / 'layer.png'}")

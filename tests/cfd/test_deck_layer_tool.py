@@ -15,7 +15,10 @@ from cfd_helpers import load_tool
 @pytest.mark.parametrize("argv, option", [(["--angle", "12"], "--angle"), (["--duration", "1"], "--duration"),
                                           (["--speed", "0"], "--speed"), (["--threads", "0"], "--threads"),
                                           (["--quality", "superb"], "--quality"),
-                                          (["--sst-walls", "resolved"], "--sst-walls")])
+                                          (["--sst-walls", "resolved"], "--sst-walls"),
+                                          (["--section", "box"], "--section"),
+                                          (["--nose-height", "1.5"], "--nose-height"),
+                                          (["--section", "plate", "--nose-height", "1"], "--nose-height")])
 def test_bad_input_exits_2_naming_the_option_and_writes_nothing(tmp_path, capsys, argv, option):
     tool = load_tool("deck_layer")
     out = tmp_path / "layer"
@@ -34,6 +37,20 @@ def test_distance_and_top_of_a_polygon():
     roof = np.array([[0.0, 0.0], [1.0, 0.0], [0.5, 0.5]])        # top: y = x up to 0.5, then 1 - x
     top = tool.top_of(roof, np.array([0.1, 0.5, 0.8, 1.5]))
     assert top[:3] == pytest.approx([0.1, 0.5, 0.2]) and np.isnan(top[3])
+
+
+def test_the_plate_control_and_the_deck_outlines():
+    tool = load_tool("deck_layer")
+    (plate,) = tool.section_polygons("plate")
+    v = plate.vertices
+    assert np.ptp(v[:, 0]) == pytest.approx(1.0) and np.ptp(v[:, 1]) == pytest.approx(tool.PLATE_THICKNESS)
+    assert tool.top_of(v, np.array([-0.3, 0.0, 0.4])) == pytest.approx([tool.PLATE_THICKNESS / 2] * 3)
+    (deck,) = tool.section_polygons("great_belt")
+    assert np.ptp(deck.vertices[:, 0]) == pytest.approx(1.0) and np.ptp(deck.vertices[:, 1]) == pytest.approx(4.4 / 31)
+    (roofline,) = tool.section_polygons("great_belt", nose_height=1.0)   # the nose on the roof: a straight top
+    crown, edge = 2.2 / 31, 2.2 / 31 - 0.02 * 0.5
+    assert tool.top_of(roofline.vertices, np.array([-0.5, -0.25, 0.0])) == pytest.approx([edge, 0.5 * (edge + crown),
+                                                                                            crown])
 
 
 def test_the_first_free_cell_lies_above_the_surface_and_outside_the_forcing():
@@ -75,6 +92,11 @@ def test_a_short_run_reads_the_layer_over_the_top(tmp_path):
     assert profile[:, -1].min() > 0.5          # 0.1 B above the top: outside the layer after 2 B/V
     ratio = np.array(got["first_cell_omega_over_log"])
     assert ratio.shape == x.shape and np.isfinite(ratio).all() and ratio.min() > 0
+    assert 0 < got["C_D"] < 1 and abs(got["C_L"]) < 1 and abs(got["C_M"]) < 1
+    bottom = got["bottom"]                    # the side below, read as the top of the mirrored section
+    assert bottom["x_from_nose"] == got["x_from_nose"]
+    assert 0 < min(bottom["first_cell_distance"]) and max(bottom["first_cell_distance"]) < 0.1
+    assert np.array(bottom["u_at_heights"])[:, -1].min() > 0.5
 
 
 @pytest.mark.slow
