@@ -227,7 +227,8 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--quality", default="quick", choices=sorted(QUALITY), help="aero preset (default quick)")
     ap.add_argument("--section", choices=SECTIONS, default="great_belt",
-                    help="the Great Belt deck (default) or a flat plate 2 %% of the chord thick (the control)")
+                    help="the Great Belt deck (default) or a flat plate 2 %% of the chord thick (the control; "
+                         "hold it at --angle 0)")
     ap.add_argument("--nose-height", type=float, default=None,
                     help="the deck's nose_height_fraction (default the section's 0.8; 1: no corner over the top)")
     ap.add_argument("--angle", type=float, default=2.0, help="angle of attack, degrees (default 2)")

@@ -99,6 +99,24 @@ def test_a_short_run_reads_the_layer_over_the_top(tmp_path):
     assert np.array(bottom["u_at_heights"])[:, -1].min() > 0.5
 
 
+def test_the_plate_held_at_plus_and_minus_an_angle_reads_the_same_layer_on_opposite_sides(tmp_path):
+    """The bottom is read as the top of the mirrored section: a symmetric plate at +2 degrees shows under its
+    bottom what it shows over its top at -2 (to round-off), with the lift and moment reversed."""
+    tool = load_tool("deck_layer")
+    got = {}
+    for angle in ("2", "-2"):
+        out = tmp_path / angle
+        assert tool.main(["--section", "plate", "--angle", angle, "--duration", "2", "--threads", "1",
+                          "--out", str(out)]) == 0
+        got[angle] = json.loads((out / "layer.json").read_text())
+    up, down = got["2"], got["-2"]
+    assert up["C_L"] > 0.05 and down["C_L"] == pytest.approx(-up["C_L"], rel=1e-6)
+    assert down["C_M"] == pytest.approx(-up["C_M"], rel=1e-6, abs=1e-9)
+    for key in ("first_cell_u", "first_cell_distance", "u_at_heights", "first_cell_nut_over_nu"):
+        assert np.array(down["bottom"][key]) == pytest.approx(np.array(up[key]), rel=1e-6, abs=1e-9), key
+    assert not np.allclose(up["first_cell_u"], up["bottom"]["first_cell_u"], rtol=1e-3)   # the sides differ
+
+
 @pytest.mark.slow
 def test_at_the_decks_reynolds_number_the_equilibrium_layer_is_turbulent_from_the_nose_and_the_wall_functions_not(
         tmp_path):
