@@ -45,9 +45,9 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from plate_loading import _FieldAverage, _say, save_png  # noqa: E402
+from plate_loading import _FieldAverage, _say, first_free_rows, save_png  # noqa: E402
 from reynolds_study import NU_AIR  # noqa: E402
-from validate_turbulence import KAPPA, spalding_uplus_from_re  # noqa: E402
+from validate_turbulence import BETA_STAR, KAPPA, spalding_uplus_from_re  # noqa: E402
 from validate_turbulence import B as B_LOG  # noqa: E402
 
 from bridge.aero.forced_motion import QUALITY, SST_WALLS, StaticCase, preset, run_case  # noqa: E402
@@ -83,16 +83,6 @@ def top_of(vertices: np.ndarray, x: np.ndarray) -> np.ndarray:
         inside = (s >= 0) & (s <= 1)
         out[inside] = np.maximum(out[inside], y0 + s[inside] * (y1 - y0))
     return np.where(np.isfinite(out), out, np.nan)
-
-
-def first_free_rows(forced: np.ndarray, y_centres: np.ndarray, columns: np.ndarray, top: np.ndarray) -> np.ndarray:
-    """For each of ``columns``, the row of the first cell whose centre lies above ``top`` (the surface's height
-    there) and which has no forced face; ``forced`` (ny, nx) from ``ImmersedBody.forced_cells``."""
-    rows = []
-    for i, t in zip(columns, top, strict=True):
-        above = np.nonzero(y_centres > t)[0]
-        rows.append(above[np.argmax(~forced[above, i])])
-    return np.array(rows)
 
 
 def law_eddy_viscosity(speed: np.ndarray, d: np.ndarray, nu: float) -> np.ndarray:
@@ -172,7 +162,7 @@ def layer_along(fields: dict, y_centres: np.ndarray, x_centres: np.ndarray, outl
     # u_tau from the cell's speed on Spalding's law
     omega = fields["omega"][up, columns]
     u_tau = np.abs(speed) / np.maximum(spalding_uplus_from_re(np.abs(speed) * d / nu), 1e-12)
-    omega_log = u_tau / (math.sqrt(0.09) * KAPPA * d)
+    omega_log = u_tau / (math.sqrt(BETA_STAR) * KAPPA * d)
     return {"x_from_nose": (x + 0.5).tolist(), "first_cell_nut_over_nu": (first / nu).tolist(),
             "largest_nut_over_nu": largest.tolist(), "first_cell_u": speed.tolist(),
             "heights": list(HEIGHTS), "u_at_heights": profile,

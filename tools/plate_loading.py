@@ -82,15 +82,24 @@ class _FieldAverage:
         return self.sum[self.FIELDS.index(name)] / self.span
 
 
+def first_free_rows(forced: np.ndarray, y_centres: np.ndarray, columns: np.ndarray, top: np.ndarray) -> np.ndarray:
+    """For each of ``columns``, the row of the first cell whose centre lies above ``top`` (the surface's height
+    there) and which has no forced face; ``forced`` (ny, nx) from ``ImmersedBody.forced_cells``."""
+    rows = []
+    for i, t in zip(columns, top, strict=True):
+        above = np.nonzero(y_centres > t)[0]
+        rows.append(above[np.argmax(~forced[above, i])])
+    return np.array(rows)
+
+
 def surface_rows(forced: np.ndarray, y_centres: np.ndarray, columns: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """For each column, the row of the first cell above the plate (centre y > 0) and of the first below it that
-    has no forced face; ``forced`` (ny, nx) from ``ImmersedBody.forced_cells``."""
-    up, down = [], []
-    above, below = np.nonzero(y_centres > 0)[0], np.nonzero(y_centres < 0)[0][::-1]
-    for i in columns:
-        up.append(above[np.argmax(~forced[above, i])])
-        down.append(below[np.argmax(~forced[below, i])])
-    return np.array(up), np.array(down)
+    has no forced face; ``forced`` (ny, nx) from ``ImmersedBody.forced_cells``.  The side below is the side
+    above of the grid seen from beneath (rows reversed, y negated)."""
+    zero = np.zeros(len(columns))
+    up = first_free_rows(forced, y_centres, columns, zero)
+    down = len(y_centres) - 1 - first_free_rows(forced[::-1], -y_centres[::-1], columns, zero)
+    return up, down
 
 
 def our_loading(angle_deg: float, quality, thickness: float, threads: int | None) -> dict:
