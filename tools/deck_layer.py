@@ -1,7 +1,8 @@
 """The Great Belt deck's boundary layers over its top and under its bottom: laminar, turbulent, short of the
 log layer, or reversed (docs/aero.md, "The deck's own boundary layer" and "A layer turbulent from the nose").
 
-    python tools/deck_layer.py [--section great_belt|plate] [--nose-height F] [--quality quick] [--angle 2]
+    python tools/deck_layer.py [--section great_belt|plate] [--nose-height F] [--bottom-flat F]
+                               [--quality quick] [--angle 2]
                                [--speed 50] [--sst-walls equilibrium|function|blended] [--duration 20]
                                [--threads N] [--out out/deck_layer]
 
@@ -10,7 +11,9 @@ deck's Reynolds number (1e8), and the wall function's velocity profile assumes t
 the deck (``bridge.cfd.sections.great_belt_section``) at ``--angle`` on the preset's overset pair at Re = V B /
 nu_air with the k-omega SST model (``run_case`` with a ``StaticCase``), averages the body grid's eddy
 viscosity and velocity over the second half of the run (the half the static coefficients use), and gives the
-mean lift, drag and moment coefficients over that half and, along the top, at fixed stations from the nose:
+mean lift, drag and moment coefficients over that half, the same from the first free cells' pressure over the
+top and under the bottom (``pressure_loads``: where along the chord the lift is carried) and, along the top, at
+fixed stations from the nose:
 
 - nu_t / nu in the first cell above the top that no forcing touches, and the largest within 0.05 B of it;
 - that cell's speed along the chord (over V) and its distance d to the deck's surface (over B), and the speed
@@ -26,9 +29,11 @@ A layer in equilibrium with the wall law has a share near 1; a laminar one near 
 Reynolds number, best held at zero incidence, whose turbulent layer has a textbook thickness (delta / x = 0.37
 Re_x^(-1/5): under 0.01 of the chord), so that what the grid and the wall treatment add to a layer shows apart
 from the deck's shape.  ``--nose-height 1`` moves the deck's nose up onto the roof line (no fairing panel, no
-corner over the top).  The body grid rotates with the deck, so its rows run along the chord and the deck's
+corner over the top); ``--bottom-flat 0.3`` lengthens the inclined bottom panels so that the rear one rises
+at 17 degrees instead of 28.  The body grid rotates with the deck, so its rows run along the chord and the deck's
 polygon is fixed in it.  Writes ``layer.json`` and ``layer.png`` (the two eddy viscosities along the top; the
-first free cells' speed over the top and under the bottom, where a reversed layer shows) to ``--out``.
+first free cells' speed over the top and under the bottom, where a reversed layer shows; the pressure's load
+along the chord) to ``--out``.
 """
 
 from __future__ import annotations
@@ -98,17 +103,21 @@ def law_eddy_viscosity(speed: np.ndarray, d: np.ndarray, nu: float) -> np.ndarra
 SECTIONS = ("great_belt", "plate")
 
 
-def section_polygons(name: str, nose_height: float | None = None) -> list:
+def section_polygons(name: str, nose_height: float | None = None, bottom_flat: float | None = None) -> list:
     """The unit-chord polygons of ``name``: the Great Belt deck, or a flat plate ``PLATE_THICKNESS`` of the
     chord thick (``bridge.cfd.sections.FlatPlate``, square ends, as tools/plate_loading.py's): the control,
     whose layer at zero incidence has a textbook thickness.  ``nose_height``: the deck's
     ``StreamlinedBox.nose_height_fraction`` instead of its default (1 puts the nose on the roof line: no
-    fairing panel, no corner over the top)."""
+    fairing panel, no corner over the top).  ``bottom_flat``: its ``bottom_flat_fraction`` instead of the default
+    0.6 (smaller: longer, shallower inclined bottom panels; the rear one rises at 28 degrees by default, at
+    17 degrees with 0.3)."""
     if name == "plate":
         return [_unit_polygon(FlatPlate(1.0, PLATE_THICKNESS))]
     deck = great_belt_section()
     if nose_height is not None:
         deck = replace(deck, nose_height_fraction=nose_height)
+    if bottom_flat is not None:
+        deck = replace(deck, bottom_flat_fraction=bottom_flat)
     return _unit_polygons(deck)
 
 
@@ -126,21 +135,34 @@ def deck_layer(q, angle_deg: float, threads: int | None, polys: list, section: s
     for body in flow.body.bodies:
         forced |= body.forced_cells()
     fields = {"nut": average.mean("nu")[inner] - 1.0 / q.reynolds, "u": 0.5 * (u_faces[:, :-1] + u_faces[:, 1:]),
-              "forced": forced, "omega": flow.model.body.omega.q.numpy()[inner]}
+              "forced": forced, "omega": flow.model.body.omega.q.numpy()[inner], "p": average.mean("p")[inner]}
     # the side below, seen from beneath: the rows and the heights mirrored, the chordwise speed unchanged
     below = {name: a[::-1] for name, a in fields.items()}
     mirrored = [p.vertices * np.array([1.0, -1.0]) for p in polys]
     second = rec.t > 0.5 * q.static_duration   # per rho V^2 B (B^2): twice the coefficients
     forces = {name: float(2.0 * getattr(rec, force)[second].mean())
               for name, force in (("C_L", "lift"), ("C_D", "drag"), ("C_M", "moment"))}
-    return {**forces, **layer_along(fields, grid.y_centres, grid.x_centres, [p.vertices for p in polys], q.reynolds),
-            "bottom": layer_along(below, -grid.y_centres[::-1], grid.x_centres, mirrored, q.reynolds),
+    top = layer_along(fields, grid.y_centres, grid.x_centres, [p.vertices for p in polys], q.reynolds)
+    bottom = layer_along(below, -grid.y_centres[::-1], grid.x_centres, mirrored, q.reynolds)
+    return {**forces, **top, "bottom": bottom, **pressure_loads(top, bottom, grid.dx),
             "cells": rec.meta["cells"], "grids": rec.meta["grids"], "wall_s": rec.wall_s, "steps": rec.steps}
+
+
+def pressure_loads(top: dict, bottom: dict, dx: float) -> dict:
+    """Where along the chord the pressure carries the lift: the load n = C_p,bottom - C_p,top per unit chord at
+    each column (the first free cells' pressures, ``layer_along``'s "first_cell_cp"; the pressure force's
+    component normal to the chord on a surface y(x) is the integral of p over x, whatever its slope), its sum
+    C_N (the chord-normal force per 1/2 rho V^2 B: C_L within C_T sin(alpha) and the friction) and its moment
+    C_M,p about mid-chord, nose-up: what a change of the lift between grids is made of, column by column."""
+    x = np.array(top["x_from_nose"])
+    load = np.array(bottom["first_cell_cp"]) - np.array(top["first_cell_cp"])
+    return {"normal_load": load.tolist(), "C_N_pressure": float(load.sum() * dx),
+            "C_M_pressure": float(-(load * (x - 0.5)).sum() * dx)}
 
 
 def layer_along(fields: dict, y_centres: np.ndarray, x_centres: np.ndarray, outlines: list, reynolds: float) -> dict:
     """The layer over the top of ``outlines`` (unit chord, the first the section's body) from the body grid's
-    time-averaged ``fields`` (ny, nx: "nut", "u" at the cell centres, "forced", "omega"); module doc."""
+    time-averaged ``fields`` (ny, nx: "nut", "u" and "p" at the cell centres, "forced", "omega"); module doc."""
     nu = 1.0 / reynolds
     nut, u = fields["nut"], fields["u"]
     columns = np.nonzero(np.abs(x_centres) < 0.5)[0]
@@ -161,6 +183,7 @@ def layer_along(fields: dict, y_centres: np.ndarray, x_centres: np.ndarray, outl
     # the specific dissipation at the end of the run against the log layer's u_tau / (sqrt(beta*) kappa d),
     # u_tau from the cell's speed on Spalding's law
     omega = fields["omega"][up, columns]
+    cp = 2.0 * fields["p"][up, columns]      # per 1/2 rho V^2, V = rho = 1; the body grid's pressure level
     u_tau = np.abs(speed) / np.maximum(spalding_uplus_from_re(np.abs(speed) * d / nu), 1e-12)
     omega_log = u_tau / (math.sqrt(BETA_STAR) * KAPPA * d)
     return {"x_from_nose": (x + 0.5).tolist(), "first_cell_nut_over_nu": (first / nu).tolist(),
@@ -168,7 +191,7 @@ def layer_along(fields: dict, y_centres: np.ndarray, x_centres: np.ndarray, outl
             "heights": list(HEIGHTS), "u_at_heights": profile,
             "first_cell_distance": d.tolist(), "law_nut_over_nu": (law / nu).tolist(),
             "share_of_law": [float(f / w) if w > 0 else None for f, w in zip(first, law, strict=True)],
-            "first_cell_omega_over_log": (omega / omega_log).tolist()}
+            "first_cell_omega_over_log": (omega / omega_log).tolist(), "first_cell_cp": cp.tolist()}
 
 
 def _table(got: dict) -> None:
@@ -191,7 +214,7 @@ def _plot(path: Path, got: dict) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, (ax, bx) = plt.subplots(1, 2, figsize=(11, 4))
+    fig, (ax, bx, cx) = plt.subplots(1, 3, figsize=(16, 4))
     x = np.array(got["x_from_nose"])
     ax.semilogy(x, np.maximum(got["first_cell_nut_over_nu"], 1e-3), ".-", ms=3, lw=1, label="first free cell")
     ax.semilogy(x, np.maximum(got["largest_nut_over_nu"], 1e-3), ".-", ms=3, lw=1,
@@ -209,6 +232,12 @@ def _plot(path: Path, got: dict) -> None:
     bx.set_ylabel("u / V along the chord (below 0: reversed)")
     bx.grid(alpha=0.3)
     bx.legend()
+    cx.plot(x, got["normal_load"], ".-", ms=3, lw=1)
+    cx.axhline(0.0, color="k", lw=0.5)
+    cx.set_xlabel("x / B from the nose")
+    cx.set_ylabel("C_p,bottom - C_p,top (first free cells)")
+    cx.set_title(f"C_N {got['C_N_pressure']:+.3f} (C_L {got['C_L']:+.3f})", fontsize=9)
+    cx.grid(alpha=0.3)
     fig.tight_layout()
     save_png(path, fig)
 
@@ -221,6 +250,9 @@ def main(argv=None) -> int:
                          "hold it at --angle 0)")
     ap.add_argument("--nose-height", type=float, default=None,
                     help="the deck's nose_height_fraction (default the section's 0.8; 1: no corner over the top)")
+    ap.add_argument("--bottom-flat", type=float, default=None,
+                    help="the deck's bottom_flat_fraction (default the section's 0.6; smaller: shallower "
+                         "inclined bottom panels)")
     ap.add_argument("--angle", type=float, default=2.0, help="angle of attack, degrees (default 2)")
     ap.add_argument("--speed", type=float, default=50.0, help="wind speed [m/s]: Re = V B / nu_air (default 50)")
     ap.add_argument("--sst-walls", choices=[w for w in SST_WALLS if w != "resolved"], default="equilibrium",
@@ -234,27 +266,31 @@ def main(argv=None) -> int:
             ("--speed", args.speed, args.speed > 0, "> 0"),
             ("--duration", args.duration, args.duration >= 2.0, ">= 2"),
             ("--threads", args.threads, args.threads is None or args.threads >= 1, ">= 1"),
-            ("--nose-height", args.nose_height, args.nose_height is None or 0.0 < args.nose_height <= 1.0, "(0, 1]")):
+            ("--nose-height", args.nose_height, args.nose_height is None or 0.0 < args.nose_height <= 1.0, "(0, 1]"),
+            ("--bottom-flat", args.bottom_flat, args.bottom_flat is None or 0.0 <= args.bottom_flat < 1.0, "[0, 1)")):
         if not ok:
             ap.error(f"{name}: {value:g} not allowed; must be {allowed}")
     section = great_belt_section()
     try:
         q = replace(preset(args.quality, "overset"), turbulence="sst", reynolds=args.speed * section.chord_m / NU_AIR,
                     sst_walls=args.sst_walls, static_duration=args.duration)
-        if args.nose_height is not None and args.section != "great_belt":
-            raise InputError("--nose-height", args.nose_height, "applies to --section great_belt only")
-        polys = section_polygons(args.section, args.nose_height)
+        for option, value in (("--nose-height", args.nose_height), ("--bottom-flat", args.bottom_flat)):
+            if value is not None and args.section != "great_belt":
+                raise InputError(option, value, "applies to --section great_belt only")
+        polys = section_polygons(args.section, args.nose_height, args.bottom_flat)
         check_output_root(args.out)
     except (InputError, ValueError) as err:
         ap.error(str(err))
     got = deck_layer(q, args.angle, args.threads, polys, args.section)
-    result = {"section": args.section, "nose_height_fraction": args.nose_height, "angle_deg": args.angle,
+    result = {"section": args.section, "nose_height_fraction": args.nose_height,
+              "bottom_flat_fraction": args.bottom_flat, "angle_deg": args.angle,
               "speed_m_s": args.speed, "reynolds": q.reynolds, "quality": args.quality,
               "cells_per_chord": q.cells_per_chord, "sst_walls": args.sst_walls, "duration": args.duration, **got}
     print(f"{args.section} at {args.angle:g} deg, Re {q.reynolds:.3g}, {args.quality} "
           f"({q.cells_per_chord} cells per chord), "
           f"SST walls {args.sst_walls}; second half of {args.duration:g} B/V")
     print("  C_L {C_L:+.4f}   C_D {C_D:.4f}   C_M {C_M:+.4f}   (means over the second half)".format(**got))
+    print("  from the first free cells' pressure: C_N {C_N_pressure:+.4f}   C_M {C_M_pressure:+.4f}".format(**got))
     for side, beyond, values in (("top", "above the top", got), ("bottom", "below the bottom", got["bottom"])):
         print(f"{side}:\n  x/B   first free cell nu_t/nu   largest within {BAND:g} B   u/V     d/B      law's nu_t/nu"
               "   share   u/V at " + " / ".join(f"{h:g}" for h in HEIGHTS) + f" B {beyond}   omega/omega_log")

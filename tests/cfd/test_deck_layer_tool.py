@@ -18,7 +18,10 @@ from cfd_helpers import load_tool
                                           (["--sst-walls", "resolved"], "--sst-walls"),
                                           (["--section", "box"], "--section"),
                                           (["--nose-height", "1.5"], "--nose-height"),
-                                          (["--section", "plate", "--nose-height", "1"], "--nose-height")])
+                                          (["--section", "plate", "--nose-height", "1"], "--nose-height"),
+                                          (["--bottom-flat", "1"], "--bottom-flat"),
+                                          (["--bottom-flat", "-0.1"], "--bottom-flat"),
+                                          (["--section", "plate", "--bottom-flat", "0.3"], "--bottom-flat")])
 def test_bad_input_exits_2_naming_the_option_and_writes_nothing(tmp_path, capsys, argv, option):
     tool = load_tool("deck_layer")
     out = tmp_path / "layer"
@@ -51,6 +54,27 @@ def test_the_plate_control_and_the_deck_outlines():
     crown, edge = 2.2 / 31, 2.2 / 31 - 0.02 * 0.5
     assert tool.top_of(roofline.vertices, np.array([-0.5, -0.25, 0.0])) == pytest.approx([edge, 0.5 * (edge + crown),
                                                                                             crown])
+    # a shallower bottom: the flat part 0.3 of the chord wide, the rear panel rising from x = 0.15 to the nose
+    (shallow,) = tool.section_polygons("great_belt", bottom_flat=0.3)
+    beneath = shallow.vertices * np.array([1.0, -1.0])                 # the bottom seen as a top
+    nose = -2.2 / 31 + 0.8 * (4.4 / 31 - 0.01)
+    assert tool.top_of(beneath, np.array([0.0, 0.15, 0.325, 0.5])) == pytest.approx(
+        [2.2 / 31, 2.2 / 31, 0.5 * (2.2 / 31 - nose), -nose])
+    assert math.degrees(math.atan((nose + 2.2 / 31) / 0.35)) == pytest.approx(16.8, abs=0.1)
+
+
+def test_the_pressure_load_sums_to_the_normal_force_and_its_moment_about_mid_chord():
+    """Midpoint sums over the columns, exact for loads linear in x: a uniform load of 1 gives C_N = 1 and no
+    moment; the same on the front half only, C_N = 1/2 at the quarter chord: C_M = 1/2 x 1/4, nose-up."""
+    tool = load_tool("deck_layer")
+    n = 40
+    x = ((np.arange(n) + 0.5) / n).tolist()
+    top = {"x_from_nose": x, "first_cell_cp": [-0.3] * n}           # suction over the top
+    uniform = tool.pressure_loads(top, {"first_cell_cp": [0.7] * n}, 1.0 / n)
+    assert uniform["C_N_pressure"] == pytest.approx(1.0) and uniform["C_M_pressure"] == pytest.approx(0.0, abs=1e-12)
+    front = tool.pressure_loads(top, {"first_cell_cp": [0.7 if xi < 0.5 else -0.3 for xi in x]}, 1.0 / n)
+    assert front["C_N_pressure"] == pytest.approx(0.5) and front["C_M_pressure"] == pytest.approx(0.125)
+    assert front["normal_load"][:2] == pytest.approx([1.0, 1.0]) and front["normal_load"][-1] == pytest.approx(0.0)
 
 
 def test_the_first_free_cell_lies_above_the_surface_and_outside_the_forcing():
@@ -97,6 +121,8 @@ def test_a_short_run_reads_the_layer_over_the_top(tmp_path):
     assert bottom["x_from_nose"] == got["x_from_nose"]
     assert 0 < min(bottom["first_cell_distance"]) and max(bottom["first_cell_distance"]) < 0.1
     assert np.array(bottom["u_at_heights"])[:, -1].min() > 0.5
+    assert len(got["normal_load"]) == len(x) and np.isfinite(got["normal_load"]).all()
+    assert got["C_N_pressure"] * got["C_L"] > 0        # the lift's sign from the pressure samples
 
 
 def test_the_plate_held_at_plus_and_minus_an_angle_reads_the_same_layer_on_opposite_sides(tmp_path):
@@ -112,6 +138,11 @@ def test_the_plate_held_at_plus_and_minus_an_angle_reads_the_same_layer_on_oppos
     up, down = got["2"], got["-2"]
     assert up["C_L"] > 0.05 and down["C_L"] == pytest.approx(-up["C_L"], rel=1e-6)
     assert down["C_M"] == pytest.approx(-up["C_M"], rel=1e-6, abs=1e-9)
+    for key in ("C_N_pressure", "C_M_pressure"):           # the pressure read on both sides, mirrored
+        assert down[key] == pytest.approx(-up[key], rel=1e-6, abs=1e-9), key
+    below, above = np.array(down["bottom"]["first_cell_cp"]), np.array(up["first_cell_cp"])
+    # the pressure's level is free (the Poisson solve fixes its gradient); its shape is mirrored
+    assert below - below.mean() == pytest.approx(above - above.mean(), rel=1e-6, abs=1e-9)
     for key in ("first_cell_u", "first_cell_distance", "u_at_heights", "first_cell_nut_over_nu"):
         assert np.array(down["bottom"][key]) == pytest.approx(np.array(up[key]), rel=1e-6, abs=1e-9), key
     assert not np.allclose(up["first_cell_u"], up["bottom"]["first_cell_u"], rtol=1e-3)   # the sides differ
