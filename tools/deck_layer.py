@@ -135,7 +135,12 @@ def deck_layer(q, angle_deg: float, threads: int | None, polys: list, section: s
     for body in flow.body.bodies:
         forced |= body.forced_cells()
     fields = {"nut": average.mean("nu")[inner] - 1.0 / q.reynolds, "u": 0.5 * (u_faces[:, :-1] + u_faces[:, 1:]),
-              "forced": forced, "omega": flow.model.body.omega.q.numpy()[inner], "p": average.mean("p")[inner]}
+              "forced": forced, "omega": flow.model.body.omega.q.numpy()[inner]}
+    # the pressure's level is free: measured from its mean over the body grid's outermost ring of cells (the
+    # same place, 0.35 B and more from the deck, on every preset; the same ring seen from beneath), so that
+    # the sides' pressures compare between grids
+    p = average.mean("p")[inner]
+    fields["p"] = p - np.concatenate([p[0], p[-1], p[1:-1, 0], p[1:-1, -1]]).mean()
     # the side below, seen from beneath: the rows and the heights mirrored, the chordwise speed unchanged
     below = {name: a[::-1] for name, a in fields.items()}
     mirrored = [p.vertices * np.array([1.0, -1.0]) for p in polys]
@@ -183,7 +188,7 @@ def layer_along(fields: dict, y_centres: np.ndarray, x_centres: np.ndarray, outl
     # the specific dissipation at the end of the run against the log layer's u_tau / (sqrt(beta*) kappa d),
     # u_tau from the cell's speed on Spalding's law
     omega = fields["omega"][up, columns]
-    cp = 2.0 * fields["p"][up, columns]      # per 1/2 rho V^2, V = rho = 1; the body grid's pressure level
+    cp = 2.0 * fields["p"][up, columns]      # per 1/2 rho V^2, V = rho = 1
     u_tau = np.abs(speed) / np.maximum(spalding_uplus_from_re(np.abs(speed) * d / nu), 1e-12)
     omega_log = u_tau / (math.sqrt(BETA_STAR) * KAPPA * d)
     return {"x_from_nose": (x + 0.5).tolist(), "first_cell_nut_over_nu": (first / nu).tolist(),
