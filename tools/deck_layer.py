@@ -19,6 +19,7 @@ fixed stations from the nose:
 - that cell's speed along the chord (over V) and its distance d to the deck's surface (over B), and the speed
   at 0.01, 0.02, 0.05 and 0.1 B above the top (interpolated in the column): how thick the layer is;
 - the specific dissipation omega there at the end of the run, over the log layer's u_tau / (sqrt(beta*) kappa d);
+- the layer's displacement thickness up to 0.1 B (``displacement_thickness``), the speed there its edge's;
 - the eddy viscosity of the law of the wall at that cell, nu (dy+/du+ - 1) on Spalding's profile through the
   cell's speed and distance (kappa u_tau d in the log layer), and the cell's share of it.
 
@@ -88,6 +89,19 @@ def top_of(vertices: np.ndarray, x: np.ndarray) -> np.ndarray:
         inside = (s >= 0) & (s <= 1)
         out[inside] = np.maximum(out[inside], y0 + s[inside] * (y1 - y0))
     return np.where(np.isfinite(out), out, np.nan)
+
+
+def displacement_thickness(y_centres: np.ndarray, u: np.ndarray, top: float, height: float) -> float:
+    """delta* = integral of (1 - u / u_e) from the surface at ``top`` up to ``top + height``, u_e the speed there
+    (interpolated in the column ``u`` at ``y_centres``): the trapezoidal rule on the cell centres in between,
+    with u = 0 on the surface (the section held still), whatever forcing the cells under the first free one
+    carry."""
+    edge = top + height
+    inside = (y_centres > top) & (y_centres < edge)
+    ys = np.concatenate([[top], y_centres[inside], [edge]])
+    ue = float(np.interp(edge, y_centres, u))
+    deficit = 1.0 - np.concatenate([[0.0], u[inside], [ue]]) / ue
+    return float(np.sum(0.5 * (deficit[1:] + deficit[:-1]) * np.diff(ys)))
 
 
 def law_eddy_viscosity(speed: np.ndarray, d: np.ndarray, nu: float) -> np.ndarray:
@@ -183,6 +197,8 @@ def layer_along(fields: dict, y_centres: np.ndarray, x_centres: np.ndarray, outl
     speed = u[up, columns]
     profile = [[float(np.interp(t + h, y_centres, u[:, i])) for h in HEIGHTS] for i, t in zip(columns, top,
                                                                                               strict=True)]
+    displacement = [displacement_thickness(y_centres, u[:, i], t, HEIGHTS[-1]) for i, t in zip(columns, top,
+                                                                                                strict=True)]
     law = law_eddy_viscosity(speed, d, nu)
     first = nut[up, columns]
     # the specific dissipation at the end of the run against the log layer's u_tau / (sqrt(beta*) kappa d),
@@ -196,7 +212,8 @@ def layer_along(fields: dict, y_centres: np.ndarray, x_centres: np.ndarray, outl
             "heights": list(HEIGHTS), "u_at_heights": profile,
             "first_cell_distance": d.tolist(), "law_nut_over_nu": (law / nu).tolist(),
             "share_of_law": [float(f / w) if w > 0 else None for f, w in zip(first, law, strict=True)],
-            "first_cell_omega_over_log": (omega / omega_log).tolist(), "first_cell_cp": cp.tolist()}
+            "first_cell_omega_over_log": (omega / omega_log).tolist(), "first_cell_cp": cp.tolist(),
+            "displacement_thickness": displacement}
 
 
 def _table(got: dict) -> None:
@@ -206,7 +223,7 @@ def _table(got: dict) -> None:
               f"   {got['first_cell_u'][i]:+.3f}  {got['first_cell_distance'][i]:.4f}   "
               f"{got['law_nut_over_nu'][i]:14.3g}   {_share(got['share_of_law'][i])}   "
               + " / ".join(f"{v:.3f}" for v in got["u_at_heights"][i])
-              + f"   {got['first_cell_omega_over_log'][i]:.3g}")
+              + f"   {got['first_cell_omega_over_log'][i]:.3g}   {got['displacement_thickness'][i]:.4f}")
 
 
 def _share(value: float | None) -> str:
@@ -298,7 +315,8 @@ def main(argv=None) -> int:
     print("  from the first free cells' pressure: C_N {C_N_pressure:+.4f}   C_M {C_M_pressure:+.4f}".format(**got))
     for side, beyond, values in (("top", "above the top", got), ("bottom", "below the bottom", got["bottom"])):
         print(f"{side}:\n  x/B   first free cell nu_t/nu   largest within {BAND:g} B   u/V     d/B      law's nu_t/nu"
-              "   share   u/V at " + " / ".join(f"{h:g}" for h in HEIGHTS) + f" B {beyond}   omega/omega_log")
+              "   share   u/V at " + " / ".join(f"{h:g}" for h in HEIGHTS)
+              + f" B {beyond}   omega/omega_log   delta*/B")
         _table(values)
     atomic_write_text(args.out / "layer.json", json.dumps(result, indent=1))
     _plot(args.out / "layer.png", got)

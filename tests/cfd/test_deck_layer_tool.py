@@ -77,6 +77,18 @@ def test_the_pressure_load_sums_to_the_normal_force_and_its_moment_about_mid_cho
     assert front["normal_load"][:2] == pytest.approx([1.0, 1.0]) and front["normal_load"][-1] == pytest.approx(0.0)
 
 
+def test_the_displacement_thickness_of_a_linear_layer_is_half_its_thickness():
+    """u = (y - top) / a up to a, then 1: delta* = a / 2, exact on the trapezoid when a cell centre lies at a;
+    a uniform stream over the wall gives half the gap to the first centre (u = 0 on the wall)."""
+    tool = load_tool("deck_layer")
+    y = np.arange(-0.5, 1.0, 0.01) + 0.005                         # centres at 0.005, 0.015, ...
+    top, a = 0.002, 0.043                                          # a cell centre at top + a = 0.045
+    u = np.clip((y - top) / a, 0.0, 1.0)
+    assert tool.displacement_thickness(y, u, top, 0.1) == pytest.approx(a / 2, rel=1e-12)
+    assert tool.displacement_thickness(y, np.ones_like(y), top, 0.1) == pytest.approx(0.5 * (0.005 - top))
+    assert tool.displacement_thickness(y, 2 * u, top, 0.1) == pytest.approx(a / 2, rel=1e-12)   # u / u_e
+
+
 def test_the_first_free_cell_lies_above_the_surface_and_outside_the_forcing():
     tool = load_tool("deck_layer")
     y = (np.arange(10) - 4.5) * 0.1
@@ -121,6 +133,8 @@ def test_a_short_run_reads_the_layer_over_the_top(tmp_path):
     assert bottom["x_from_nose"] == got["x_from_nose"]
     assert 0 < min(bottom["first_cell_distance"]) and max(bottom["first_cell_distance"]) < 0.1
     assert np.array(bottom["u_at_heights"])[:, -1].min() > 0.5
+    thickness = np.array(got["displacement_thickness"])
+    assert thickness.shape == x.shape and thickness.min() > 0 and thickness.max() < 0.1
     assert len(got["normal_load"]) == len(x) and np.isfinite(got["normal_load"]).all()
     assert got["C_N_pressure"] * got["C_L"] > 0        # the lift's sign from the pressure samples
 
@@ -142,7 +156,8 @@ def test_the_plate_held_at_plus_and_minus_an_angle_reads_the_same_layer_on_oppos
         assert down[key] == pytest.approx(-up[key], rel=1e-6, abs=1e-9), key
     assert np.array(down["bottom"]["first_cell_cp"]) == pytest.approx(np.array(up["first_cell_cp"]), rel=1e-6,
                                                                         abs=1e-9)
-    for key in ("first_cell_u", "first_cell_distance", "u_at_heights", "first_cell_nut_over_nu"):
+    for key in ("first_cell_u", "first_cell_distance", "u_at_heights", "first_cell_nut_over_nu",
+                "displacement_thickness"):
         assert np.array(down["bottom"][key]) == pytest.approx(np.array(up[key]), rel=1e-6, abs=1e-9), key
     assert not np.allclose(up["first_cell_u"], up["bottom"]["first_cell_u"], rtol=1e-3)   # the sides differ
 
