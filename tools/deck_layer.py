@@ -58,6 +58,7 @@ from validate_turbulence import B as B_LOG  # noqa: E402
 
 from bridge.aero.forced_motion import QUALITY, SST_WALLS, StaticCase, preset, run_case  # noqa: E402
 from bridge.aero.stage import _unit_polygon, _unit_polygons  # noqa: E402
+from bridge.aero.static import chordwise_loading  # noqa: E402
 from bridge.cfd.grids import GHOST  # noqa: E402
 from bridge.cfd.sections import FlatPlate, great_belt_section  # noqa: E402
 from bridge.errors import InputError  # noqa: E402
@@ -173,11 +174,12 @@ def pressure_loads(top: dict, bottom: dict, dx: float) -> dict:
     each column (the first free cells' pressures, ``layer_along``'s "first_cell_cp"; the pressure force's
     component normal to the chord on a surface y(x) is the integral of p over x, whatever its slope), its sum
     C_N (the chord-normal force per 1/2 rho V^2 B: C_L within C_T sin(alpha) and the friction) and its moment
-    C_M,p about mid-chord, nose-up: what a change of the lift between grids is made of, column by column."""
+    C_M,p about mid-chord, nose-up (``bridge.aero.static.chordwise_loading``'s sums; its thin-plate strips are not
+    used): what a change of the lift between grids is made of, column by column."""
     x = np.array(top["x_from_nose"])
     load = np.array(bottom["first_cell_cp"]) - np.array(top["first_cell_cp"])
-    return {"normal_load": load.tolist(), "C_N_pressure": float(load.sum() * dx),
-            "C_M_pressure": float(-(load * (x - 0.5)).sum() * dx)}
+    sums = chordwise_loading(x, load, np.full(x.size, dx), 0.0)
+    return {"normal_load": load.tolist(), "C_N_pressure": sums.lift, "C_M_pressure": sums.moment}
 
 
 def layer_along(fields: dict, y_centres: np.ndarray, x_centres: np.ndarray, outlines: list, reynolds: float) -> dict:
