@@ -2,7 +2,8 @@
 log layer, or reversed (docs/aero.md, "The deck's own boundary layer" and "A layer turbulent from the nose").
 
     python tools/deck_layer.py [--section great_belt|plate] [--nose-height F] [--bottom-flat F]
-                               [--quality quick] [--angle 2]
+                               [--quality quick] [--cells-per-chord N] [--background-coarsening M]
+                               [--angle 2]
                                [--speed 50] [--sst-walls equilibrium|function|blended] [--duration 20]
                                [--threads N] [--out out/deck_layer]
 
@@ -34,7 +35,10 @@ corner over the top); ``--bottom-flat 0.3`` lengthens the inclined bottom panels
 at 17 degrees instead of 28.  The body grid rotates with the deck, so its rows run along the chord and the deck's
 polygon is fixed in it.  Writes ``layer.json`` and ``layer.png`` (the two eddy viscosities along the top; the
 first free cells' speed over the top and under the bottom, where a reversed layer shows; the pressure's load
-along the chord) to ``--out``.
+along the chord) to ``--out``.  ``--cells-per-chord`` and ``--background-coarsening`` replace the preset's
+body grid spacing and the background's coarsening on the preset's domain (a grid study beyond ``fine``, or the
+background's share), and the JSON keeps the lift's record (``C_L_record``, one value per 0.1 B/V) so that the
+settling of the mean shows.
 """
 
 from __future__ import annotations
@@ -67,6 +71,7 @@ from bridge.files import atomic_write_text, check_output_root  # noqa: E402
 STATIONS = (0.1, 0.2, 0.4, 0.6, 0.8, 0.95, 0.97)   # x / B from the nose
 HEIGHTS = (0.01, 0.02, 0.05, 0.1)                 # above the top, B: the speed profile through the layer
 PLATE_THICKNESS = 0.02                            # of the chord, --section plate
+RECORD_STEP = 0.1                                 # B/V between the values of the kept lift record
 BAND = 0.05                                       # the height above the top searched for the largest nu_t
 
 
@@ -163,10 +168,13 @@ def deck_layer(q, angle_deg: float, threads: int | None, polys: list, section: s
     second = rec.t > 0.5 * q.static_duration   # per rho V^2 B (B^2): twice the coefficients
     forces = {name: float(2.0 * getattr(rec, force)[second].mean())
               for name, force in (("C_L", "lift"), ("C_D", "drag"), ("C_M", "moment"))}
+    record_t = np.arange(0.0, float(rec.t[-1]) + 1e-9, RECORD_STEP)
+    record = 2.0 * np.interp(record_t, rec.t, rec.lift)
     top = layer_along(fields, grid.y_centres, grid.x_centres, [p.vertices for p in polys], q.reynolds)
     bottom = layer_along(below, -grid.y_centres[::-1], grid.x_centres, mirrored, q.reynolds)
     return {**forces, **top, "bottom": bottom, **pressure_loads(top, bottom, grid.dx),
-            "cells": rec.meta["cells"], "grids": rec.meta["grids"], "wall_s": rec.wall_s, "steps": rec.steps}
+            "cells": rec.meta["cells"], "grids": rec.meta["grids"], "wall_s": rec.wall_s, "steps": rec.steps,
+            "C_L_record": [round(float(c), 6) for c in record]}
 
 
 def pressure_loads(top: dict, bottom: dict, dx: float) -> dict:
@@ -270,6 +278,10 @@ def _plot(path: Path, got: dict) -> None:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--quality", default="quick", choices=sorted(QUALITY), help="aero preset (default quick)")
+    ap.add_argument("--cells-per-chord", type=int, default=None,
+                    help="the body grid's cells per chord (default the preset's: 16 / 40 / 80)")
+    ap.add_argument("--background-coarsening", type=int, default=None,
+                    help="the background's cells this many times the body grid's (default the preset's 2)")
     ap.add_argument("--section", choices=SECTIONS, default="great_belt",
                     help="the Great Belt deck (default) or a flat plate 2 %% of the chord thick (the control; "
                          "hold it at --angle 0)")
@@ -290,6 +302,10 @@ def main(argv=None) -> int:
             ("--angle", args.angle, abs(args.angle) <= 10.0, "-10 to 10 degrees"),
             ("--speed", args.speed, args.speed > 0, "> 0"),
             ("--duration", args.duration, args.duration >= 2.0, ">= 2"),
+            ("--cells-per-chord", args.cells_per_chord,
+             args.cells_per_chord is None or 8 <= args.cells_per_chord <= 2000, "8 to 2000"),
+            ("--background-coarsening", args.background_coarsening,
+             args.background_coarsening is None or 1 <= args.background_coarsening <= 16, "1 to 16"),
             ("--threads", args.threads, args.threads is None or args.threads >= 1, ">= 1"),
             ("--nose-height", args.nose_height, args.nose_height is None or 0.0 < args.nose_height <= 1.0, "(0, 1]"),
             ("--bottom-flat", args.bottom_flat, args.bottom_flat is None or 0.0 <= args.bottom_flat < 1.0, "[0, 1)")):
@@ -299,6 +315,10 @@ def main(argv=None) -> int:
     try:
         q = replace(preset(args.quality, "overset"), turbulence="sst", reynolds=args.speed * section.chord_m / NU_AIR,
                     sst_walls=args.sst_walls, static_duration=args.duration)
+        if args.cells_per_chord is not None:
+            q = replace(q, cells_per_chord=args.cells_per_chord)
+        if args.background_coarsening is not None:
+            q = replace(q, background_coarsening=args.background_coarsening)
         for option, value in (("--nose-height", args.nose_height), ("--bottom-flat", args.bottom_flat)):
             if value is not None and args.section != "great_belt":
                 raise InputError(option, value, "applies to --section great_belt only")
@@ -310,9 +330,10 @@ def main(argv=None) -> int:
     result = {"section": args.section, "nose_height_fraction": args.nose_height,
               "bottom_flat_fraction": args.bottom_flat, "angle_deg": args.angle,
               "speed_m_s": args.speed, "reynolds": q.reynolds, "quality": args.quality,
-              "cells_per_chord": q.cells_per_chord, "sst_walls": args.sst_walls, "duration": args.duration, **got}
+              "cells_per_chord": q.cells_per_chord, "background_coarsening": q.background_coarsening,
+              "sst_walls": args.sst_walls, "duration": args.duration, **got}
     print(f"{args.section} at {args.angle:g} deg, Re {q.reynolds:.3g}, {args.quality} "
-          f"({q.cells_per_chord} cells per chord), "
+          f"({q.cells_per_chord} cells per chord, background x{q.background_coarsening}), "
           f"SST walls {args.sst_walls}; second half of {args.duration:g} B/V")
     print("  C_L {C_L:+.4f}   C_D {C_D:.4f}   C_M {C_M:+.4f}   (means over the second half)".format(**got))
     print("  from the first free cells' pressure: C_N {C_N_pressure:+.4f}   C_M {C_M_pressure:+.4f}".format(**got))

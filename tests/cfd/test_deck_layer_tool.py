@@ -21,7 +21,9 @@ from cfd_helpers import load_tool
                                           (["--section", "plate", "--nose-height", "1"], "--nose-height"),
                                           (["--bottom-flat", "1"], "--bottom-flat"),
                                           (["--bottom-flat", "-0.1"], "--bottom-flat"),
-                                          (["--section", "plate", "--bottom-flat", "0.3"], "--bottom-flat")])
+                                          (["--section", "plate", "--bottom-flat", "0.3"], "--bottom-flat"),
+                                          (["--cells-per-chord", "4"], "--cells-per-chord"),
+                                          (["--background-coarsening", "0"], "--background-coarsening")])
 def test_bad_input_exits_2_naming_the_option_and_writes_nothing(tmp_path, capsys, argv, option):
     tool = load_tool("deck_layer")
     out = tmp_path / "layer"
@@ -115,8 +117,17 @@ def test_the_laws_eddy_viscosity_is_kappa_u_tau_d_in_the_log_layer_and_vanishes_
 def test_a_short_run_reads_the_layer_over_the_top(tmp_path):
     tool = load_tool("deck_layer")
     out = tmp_path / "layer"
-    assert tool.main(["--duration", "2", "--threads", "1", "--out", str(out)]) == 0
+    assert tool.main(["--duration", "2", "--threads", "1", "--cells-per-chord", "12", "--background-coarsening", "3",
+                      "--out", str(out)]) == 0
     got = json.loads((out / "layer.json").read_text())
+    # the grid as asked, not the preset's 16 cells per chord over a background of 8: the background's cells are
+    # 1/4 chord, and the body grid, reaching 6 of them (1.5 B) beyond the deck, moves the inflow from 3 to 4 chords
+    # upstream: 4 + 20 chords at 4 cells
+    assert got["cells_per_chord"] == 12 and got["background_coarsening"] == 3
+    assert got["grids"].startswith("96 x ")
+    record = np.array(got["C_L_record"])             # one value per 0.1 B/V, t = 0 to 2
+    assert record.shape == (21,) and np.isfinite(record).all()
+    assert abs(record[11:].mean() - got["C_L"]) < 0.01   # the second half's mean, from every step: the same lift
     assert (out / "layer.png").stat().st_size > 1000
     x = np.array(got["x_from_nose"])
     assert x.min() > 0 and x.max() < 1 and len(x) == got["cells_per_chord"]
