@@ -15,6 +15,11 @@ DFG 2D-2 (``dfg2``): the same channel with U_max = 1.5 (Re 100, periodic sheddin
 and St = f D / U_mean over the last ``--window`` (at most half the run), the force series written next
 to ``--out`` as dfg2_ppd<N>[_bg<M>].h5 and .png. ``--overset BG_PPD`` (dfg, dfg2, heave): the body in a
 body grid of h = D/ppd spanning +-1 D (``bridge.cfd.OversetPair``) over a background of h = D/BG_PPD.
+``--save-state FILE`` (dfg2 --overset, one --ppd) keeps the background's flow at the end of the run in HDF5;
+``--start-from FILE`` starts a run at that time from that background (the same --overset) with a body
+grid of any --ppd set from it as at the start (``OversetPair.set_initial_state``): a finer body grid need
+not pay for the approach to the periodic state again, only for its own settling, which ``--window`` must
+leave out.
 DFG 2D-1 (Schaefer and Turek 1996): channel 2.2 x 0.41, D = 0.1 at (0.2, 0.2), nu = 1e-3, parabolic
 inflow U_max = 0.3, no-slip walls; c_D, c_L on U_mean = 0.2; pressure difference between the front
 and rear points of the cylinder, each extrapolated along the line y = 0.2 from the nearest cells
@@ -31,6 +36,7 @@ and the mean pressure inside the body at the end. Results are appended to ``--ou
 from __future__ import annotations
 
 import argparse
+import io
 import json
 import sys
 import time
@@ -62,6 +68,7 @@ from bridge.cfd import (  # noqa: E402
 )
 from bridge.cfd.advection import SCHEMES  # noqa: E402
 from bridge.cfd.time_stepping import TIME_SCHEMES  # noqa: E402
+from bridge.files import atomic_write_bytes  # noqa: E402
 
 BANDS = {  # docs/reference_cases.md
     20: {"C_D": (2.00, 2.09), "L_w/D": (0.91, 0.94)},
@@ -265,7 +272,8 @@ def dfg_cells_across(ppd):
 
 
 def dfg(ppd, t_end, threads, scheme, ib_order=1, ny_shift=0, overset=None, body_shift=0.0, unsteady=False,
-        window=3.0, series_out=None, body_extent=1.0, cv_lift=False, variant=None):
+        window=3.0, series_out=None, body_extent=1.0, cv_lift=False, variant=None, save_state=None,
+        start_from=None):
     """DFG 2D-1 on a uniform grid h = D/ppd; ``ny_shift`` adds cells across the channel (dy =
     0.41/(ny + ny_shift), nearly the same resolution, the cylinder cut differently by the grid).
     ``overset`` = background cells per diameter: the cylinder in a body grid of h = D/ppd spanning
@@ -275,7 +283,9 @@ def dfg(ppd, t_end, threads, scheme, ib_order=1, ny_shift=0, overset=None, body_
     ``unsteady``: DFG 2D-2 (U_max = 1.5, Re 100, periodic shedding): c_D,max, c_L,max and St over the
     last ``window``, the force series written to ``series_out`` (.h5 and .png). ``cv_lift`` (single
     grid): also the lift from a control volume of +-1.5 D (``ControlVolumeLift``). ``variant`` (a
-    ``DfgVariant``): the sensitivity changes of ``--channel-length`` and the options after it."""
+    ``DfgVariant``): the sensitivity changes of ``--channel-length`` and the options after it.
+    ``save_state`` / ``start_from`` (overset): a path the background's flow is written to at the end / read
+    from at the start (``save_background``, ``load_background``)."""
     v = variant or DfgVariant()
     d, h_ch, length, nu, umax = DFG_D, DFG_H, v.channel_length, 1e-3 * v.nu_scale, (1.5 if unsteady else 0.3)
 
@@ -312,9 +322,16 @@ def dfg(ppd, t_end, threads, scheme, ib_order=1, ny_shift=0, overset=None, body_
         n, e = int(round(2 * body_extent * ppd)), body_extent * d
         body_grid = CartesianGrid.uniform(n, n, (-e + sh, e + sh), (-e + sh, e + sh))
         pair = OversetPair(grid, body_grid, cfg, Stationary(0.2, 0.2), polygon=circle(d))
-        pair.background.set_state(u=u0)
+        if start_from is None:
+            pair.background.set_state(u=u0)
+        else:
+            load_background(pair, start_from)
+        t_start = pair.background.t
         pair.set_initial_state()
         t, f = _march_pair(pair, t_end, "DFG")
+        if save_state is not None:
+            save_background(pair, save_state, {"overset_background_ppd": overset, "ppd": ppd,
+                                               "variant": json.dumps(v._asdict())})
         probe, centre = pair.body, (0.0, 0.0)
         cells, steps = nx * ny + body_grid.nx * body_grid.ny, pair.n_steps
     wall = time.perf_counter() - t0
@@ -325,6 +342,8 @@ def dfg(ppd, t_end, threads, scheme, ib_order=1, ny_shift=0, overset=None, body_
     def phi(x, y):
         return np.hypot(x - centre[0], y - centre[1]) - d / 2
 
+    if overset is None:
+        t_start = 0.0
     dp, dp_linear = (_line_pressure(probe, centre[0] - d / 2, -1, centre[1], phi, n)
                      - _line_pressure(probe, centre[0] + d / 2, +1, centre[1], phi, n) for n in (3, 2))
     if unsteady:
@@ -334,6 +353,7 @@ def dfg(ppd, t_end, threads, scheme, ib_order=1, ny_shift=0, overset=None, body_
         row = {"case": "DFG 2D-2", "ppd": ppd, "overset_background_ppd": overset, "body_shift": body_shift,
                "body_extent": body_extent if overset else None,
                "cells": cells, "t_end": float(t[-1]), "steps": steps, "wall_s": wall, "window": window,
+               "t_start": t_start, "start_from": None if start_from is None else str(start_from),
                "c_D_max": float(cd[sel].max()), "c_L_max": float(cl[sel].max()), "c_L_min": float(cl[sel].min()),
                "St": st * d / um, "variant": v._asdict(), "band": BANDS["dfg2"]}
         if cv_lift and overset is None:
@@ -352,6 +372,38 @@ def dfg(ppd, t_end, threads, scheme, ib_order=1, ny_shift=0, overset=None, body_
             "c_D_drift_per_time": float(np.polyfit(t[last] - t[-1], scale * f[last, 0], 1)[0])
             if last.sum() > 2 else np.nan,
             "band": BANDS["dfg"]}
+
+
+def save_background(pair, path, attrs) -> None:
+    """The background's flow state (u, v, p: bridge.cfd.state), its time and ``attrs`` in the HDF5 file
+    ``path``, written whole or not at all."""
+    import h5py
+
+    buf = io.BytesIO()
+    with h5py.File(buf, "w") as fh:
+        group = fh.create_group("background")
+        pair.background.state.t, pair.background.state.n_steps = pair.background.t, pair.background.n_steps
+        pair.background.state.save(group)
+        for key, value in attrs.items():
+            fh.attrs[key] = value
+    atomic_write_bytes(Path(path), buf.getvalue())
+
+
+def saved_background(path) -> dict:
+    """The attributes of a file ``save_background`` wrote, with the background's time as ``t``."""
+    import h5py
+
+    with h5py.File(path, "r") as fh:
+        return {**dict(fh.attrs), "t": float(fh["background"].attrs["t"])}
+
+
+def load_background(pair, path) -> None:
+    """The background's flow and time from ``path`` (``save_background``); ValueError if it does not fit."""
+    import h5py
+
+    with h5py.File(path, "r") as fh:
+        pair.background.state.load(fh["background"])
+    pair.background.t, pair.background.n_steps = pair.background.state.t, 0
 
 
 def _write_series(stem: Path, t, cd, cl, row) -> None:
@@ -472,6 +524,12 @@ def main(argv=None):
     sens.add_argument("--time-scheme", choices=sorted(TIME_SCHEMES), default="heun")
     sens.add_argument("--wall-cell", type=float, default=1.0,
                       help="the walls' first cell over h (< 1: refined towards the walls, single grid)")
+    ap.add_argument("--save-state", type=Path, default=None, metavar="FILE",
+                    help="dfg2 --overset, one --ppd: the background's flow at the end, for --start-from (HDF5)")
+    ap.add_argument("--start-from", type=Path, default=None, metavar="FILE",
+                    help="dfg2 --overset: start at the time and from the background of a --save-state file (the "
+                         "same --overset and sensitivity options), the body grid set from it; --window must "
+                         "leave out the body grid's settling")
     ap.add_argument("--out", default="out/validation_cfd.jsonl")
     args = ap.parse_args(argv)
     wp.config.quiet = True
@@ -497,7 +555,8 @@ def main(argv=None):
                         unsteady=args.case == "dfg2", window=min(args.window, args.t_end / 2), series_out=stem,
                         body_extent=args.body_extent, cv_lift=args.cv_lift,
                         variant=DfgVariant(args.channel_length, args.walls, args.nu_scale, args.cfl,
-                                           args.time_scheme, args.wall_cell))
+                                           args.time_scheme, args.wall_cell),
+                        save_state=args.save_state, start_from=args.start_from)
             r["command"] = command
             _emit(r, args.out)
             results.append(r)
@@ -529,8 +588,34 @@ def _check_args(ap, args):
     for name, value, ok, allowed in checks:
         if not ok:
             ap.error(f"{name}: {value} not allowed; allowed: {allowed}")
+    _check_state_args(ap, args)
     if args.case in ("dfg", "dfg2") and any(dfg_cells_across(ppd) + k < 1 for ppd in args.ppd for k in args.ny_shift):
         ap.error(f"--ny-shift: {args.ny_shift} leaves no cells across the channel")
+
+
+def _check_state_args(ap, args):
+    """--save-state and --start-from: dfg2 on the overset pair; a start file that fits the run."""
+    for name, path in (("--save-state", args.save_state), ("--start-from", args.start_from)):
+        if path is not None and (args.case != "dfg2" or args.overset is None):
+            ap.error(f"{name}: {path} not allowed; only with the dfg2 case and --overset")
+    if args.save_state is not None and (len(args.ppd) > 1 or len(args.body_shift) > 1):
+        ap.error(f"--save-state: {args.save_state} not allowed with several --ppd or --body-shift (one run, one file)")
+    if args.start_from is None:
+        return
+    try:
+        saved = saved_background(args.start_from)
+    except (OSError, KeyError) as err:
+        ap.error(f"--start-from: {args.start_from} is not a file --save-state wrote ({err})")
+    variant = DfgVariant(args.channel_length, args.walls, args.nu_scale, args.cfl, args.time_scheme,
+                         args.wall_cell)
+    if int(saved.get("overset_background_ppd", -1)) != args.overset:
+        ap.error(f"--start-from: {args.start_from} holds a background of D/{saved.get('overset_background_ppd')}; "
+                 f"--overset must be the same, not {args.overset}")
+    if json.loads(saved.get("variant", "{}")) != json.loads(json.dumps(variant._asdict())):
+        ap.error(f"--start-from: {args.start_from} was run with other sensitivity options ({saved.get('variant')})")
+    if not args.t_end - saved["t"] > args.window:
+        ap.error(f"--t-end: {args.t_end} not allowed; must exceed the start file's time {saved['t']:g} by more than "
+                 f"--window {args.window:g} (the body grid's settling left out)")
 
 
 def _emit(r, out):

@@ -66,6 +66,34 @@ def test_validate_cfd_runs_tiny(tmp_path, capsys):
     assert res["ny"] > 25 and res["nx"] == 198 and res["variant"]["walls"] == "slip"
 
 
+def test_dfg2_starts_from_a_saved_background_and_reaches_the_same_forces(tmp_path, capsys):
+    """--save-state / --start-from: a run restarted from its own background at t = 0.1 (the body grid set from
+    it) gives the drag of the run that went through, once its settling (0.05) is left out of the window; a
+    finer body grid starts from the same file; a file that does not fit the run is refused before any run."""
+    tool, out, state = load_tool("validate_cfd"), str(tmp_path / "v.jsonl"), tmp_path / "state.h5"
+    common = ["dfg2", "--overset", "12", "--threads", "1", "--out", out]
+    (first,) = tool.main([*common, "--ppd", "24", "--t-end", "0.1", "--window", "0.05", "--save-state", str(state)])
+    assert state.exists()
+    (through,) = tool.main([*common, "--ppd", "24", "--t-end", "0.2", "--window", "0.05"])
+    (again,) = tool.main([*common, "--ppd", "24", "--t-end", "0.2", "--window", "0.05", "--start-from", str(state)])
+    assert again["t_start"] == pytest.approx(first["t_end"]) and through["t_start"] == 0.0
+    assert again["steps"] < through["steps"]
+    assert again["c_D_max"] == pytest.approx(through["c_D_max"], rel=0.01)
+    (finer,) = tool.main([*common, "--ppd", "36", "--t-end", "0.15", "--window", "0.02", "--start-from", str(state)])
+    assert finer["t_start"] == pytest.approx(first["t_end"]) and np.isfinite(finer["c_D_max"])
+    capsys.readouterr()
+    for argv, option in ((["--overset", "16", "--t-end", "0.2", "--window", "0.05"], "--start-from"),
+                         (["--overset", "12", "--t-end", "0.12", "--window", "0.05"], "--t-end"),
+                         (["--overset", "12", "--t-end", "0.2", "--window", "0.05", "--cfl", "0.3"], "--start-from")):
+        with pytest.raises(SystemExit) as exc:
+            tool.main(["dfg2", "--ppd", "24", *argv, "--start-from", str(state), "--out", str(tmp_path / "no")])
+        assert exc.value.code == 2 and option in capsys.readouterr().err
+    with pytest.raises(SystemExit) as exc:   # the single grid has no background to save
+        tool.main(["dfg2", "--ppd", "6", "--save-state", str(tmp_path / "s.h5"), "--out", str(tmp_path / "no")])
+    assert exc.value.code == 2 and "--save-state" in capsys.readouterr().err
+    assert not (tmp_path / "no").exists() and not (tmp_path / "s.h5").exists()
+
+
 @pytest.mark.parametrize("tool, argv, option", [
     ("validate_cfd", ["dfg", "--ppd", "0"], "--ppd"),
     ("validate_cfd", ["cylinder", "--re", "-5"], "--re"),
