@@ -109,6 +109,14 @@ def _strouhal(t, cl, window):
     return float(1.0 / period), (tc[0], tc[-1])
 
 
+def _period_peaks(t, cl, window):
+    """The largest c_L of each whole period of the series (between up-crossings of the last ``window``'s
+    mean lift), as (start of the period, peak): how the envelope settles."""
+    m = cl - cl[t > t[-1] - window].mean()
+    up = np.nonzero((m[:-1] < 0) & (m[1:] >= 0))[0]
+    return [(round(float(t[a]), 4), round(float(cl[a:b + 1].max()), 5)) for a, b in zip(up[:-1], up[1:], strict=True)]
+
+
 def cylinder(re, ppd, t_end, window, threads, scheme, upstream=10.0, downstream=20.0, half_height=15.0,
              ib_order=1):
     h = 1.0 / ppd
@@ -355,7 +363,8 @@ def dfg(ppd, t_end, threads, scheme, ib_order=1, ny_shift=0, overset=None, body_
                "cells": cells, "t_end": float(t[-1]), "steps": steps, "wall_s": wall, "window": window,
                "t_start": t_start, "start_from": None if start_from is None else str(start_from),
                "c_D_max": float(cd[sel].max()), "c_L_max": float(cl[sel].max()), "c_L_min": float(cl[sel].min()),
-               "St": st * d / um, "variant": v._asdict(), "band": BANDS["dfg2"]}
+               "St": st * d / um, "variant": v._asdict(), "band": BANDS["dfg2"],
+               "c_L_max_per_period": _period_peaks(t, cl, window)}
         if cv_lift and overset is None:
             cl_cv = scale * np.array(monitors[-1].f)
             row.update(c_L_max_cv=float(cl_cv[sel].max()), c_L_min_cv=float(cl_cv[sel].min()),
@@ -549,7 +558,8 @@ def main(argv=None):
             else:
                 stem = Path(args.out).with_name(f"{args.case}_ppd{ppd}" + (f"_bg{args.overset}" if args.overset else "")
                                                 + (f"_shift{variant:g}" if variant else "")
-                                                + (f"_ext{args.body_extent:g}" if args.body_extent != 1.0 else ""))
+                                                + (f"_ext{args.body_extent:g}" if args.body_extent != 1.0 else "")
+                                                + ("_restarted" if args.start_from else ""))
                 r = dfg(ppd, args.t_end, args.threads, args.advection, args.ib_order,
                         0 if args.overset else variant, args.overset, variant if args.overset else 0.0,
                         unsteady=args.case == "dfg2", window=min(args.window, args.t_end / 2), series_out=stem,

@@ -66,6 +66,16 @@ def test_validate_cfd_runs_tiny(tmp_path, capsys):
     assert res["ny"] > 25 and res["nx"] == 198 and res["variant"]["walls"] == "slip"
 
 
+def test_the_period_peaks_of_a_growing_sine_are_its_envelope():
+    t = np.linspace(0.0, 4.0, 4001)
+    envelope = 1.0 + 0.1 * t
+    peaks = load_tool("validate_cfd")._period_peaks(t, 0.2 + envelope * np.sin(2 * np.pi * t), window=2.0)
+    assert len(peaks) == 3                                   # whole periods between up-crossings only
+    starts, values = np.array(peaks).T
+    assert np.allclose(np.diff(starts), 1.0, atol=0.01)
+    assert np.allclose(values, 0.2 + 1.0 + 0.1 * (starts + 0.25), atol=0.01)   # each at its quarter period
+
+
 def test_dfg2_starts_from_a_saved_background_and_reaches_the_same_forces(tmp_path, capsys):
     """--save-state / --start-from: a run restarted from its own background at t = 0.1 (the body grid set from
     it) gives the drag of the run that went through, once its settling (0.05) is left out of the window; a
@@ -79,6 +89,9 @@ def test_dfg2_starts_from_a_saved_background_and_reaches_the_same_forces(tmp_pat
     assert again["t_start"] == pytest.approx(first["t_end"]) and through["t_start"] == 0.0
     assert again["steps"] < through["steps"]
     assert again["c_D_max"] == pytest.approx(through["c_D_max"], rel=0.01)
+    assert (tmp_path / "dfg2_ppd24_bg12_restarted.h5").exists() and (tmp_path / "dfg2_ppd24_bg12.h5").exists()
+    peaks = through["c_L_max_per_period"]   # none yet (the shedding has not started): a list of whole periods
+    assert isinstance(peaks, list) and all(len(p) == 2 for p in peaks)
     (finer,) = tool.main([*common, "--ppd", "36", "--t-end", "0.15", "--window", "0.02", "--start-from", str(state)])
     assert finer["t_start"] == pytest.approx(first["t_end"]) and np.isfinite(finer["c_D_max"])
     capsys.readouterr()
