@@ -42,7 +42,9 @@ class ProgressNote:
     given, and the wall time left at the rate so far - to ``sink`` (a callable taking the line) if given,
     else to ``stream`` (stderr by default). Works with anything that has ``t`` and ``n_steps`` (a
     ``Simulation`` or an ``OversetPair``); the rate counts from the first call, so a resumed run's
-    estimate is not skewed by the time it did not spend."""
+    estimate is not skewed by the time it did not spend, and the lines come at every ``fraction`` of what is
+    left at the first call (of the whole run when it starts at t = 0), so that a resumed run shows its
+    progress as often as a fresh one."""
 
     def __init__(self, label: str, t_end: float, fraction: float = 0.1, stream=None,
                  sink: Callable[[str], None] | None = None, detail: Callable[[object], str] | None = None):
@@ -61,7 +63,8 @@ class ProgressNote:
         now = time.perf_counter()
         if self._start is None:
             self._start = (now, sim.t)
-            self._next = sim.t + self.fraction * self.t_end
+            self._step = self.fraction * max(self.t_end - sim.t, 1e-300)
+            self._next = sim.t + self._step
         if sim.t < self._next:
             return
         wall0, t0 = self._start
@@ -70,7 +73,7 @@ class ProgressNote:
         self.sink(f"{self.label}: t = {sim.t:.4g} of {self.t_end:.4g} ({100 * sim.t / self.t_end:.0f} %), "
                   f"{sim.n_steps} steps, {extra}about {left:.0f} s left")
         while self._next <= sim.t:
-            self._next += self.fraction * self.t_end
+            self._next += self._step
 
 
 class CFLMonitor:

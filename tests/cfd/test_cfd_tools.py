@@ -38,6 +38,14 @@ def test_progress_note_writes_a_line_per_fraction_with_the_time_left():
     for n in range(11):
         note(SimpleNamespace(t=0.1 * n, n_steps=n))
     assert len(said) == 2 and said[0].startswith("heave: t = 0.5 of 1 (50 %), 5 steps, 0 periods, about ")
+    # a run resumed at t = 1.2 of 2: a line at every quarter of the 0.8 left, not only at 1.5 and 2
+    lines = io.StringIO()
+    note = ProgressNote("case", 2.0, fraction=0.25, stream=lines)
+    for n in range(120, 201):
+        note(SimpleNamespace(t=0.01 * n, n_steps=n))
+    out = lines.getvalue().splitlines()
+    assert [line.split(" of ")[0] for line in out] == ["case: t = 1.4", "case: t = 1.6", "case: t = 1.8",
+                                                       "case: t = 2"], out
 
 
 def test_validate_cfd_runs_tiny(tmp_path, capsys):
