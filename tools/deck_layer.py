@@ -3,6 +3,7 @@ log layer, or reversed (docs/aero.md, "The deck's own boundary layer" and "A lay
 
     python tools/deck_layer.py [--section great_belt|plate] [--nose-height F] [--bottom-flat F]
                                [--quality quick] [--cells-per-chord N] [--background-coarsening M]
+                               [--body-margin B]
                                [--angle 2]
                                [--speed 50] [--sst-walls equilibrium|function|blended] [--duration 20]
                                [--threads N] [--out out/deck_layer]
@@ -35,10 +36,11 @@ corner over the top); ``--bottom-flat 0.3`` lengthens the inclined bottom panels
 at 17 degrees instead of 28.  The body grid rotates with the deck, so its rows run along the chord and the deck's
 polygon is fixed in it.  Writes ``layer.json`` and ``layer.png`` (the two eddy viscosities along the top; the
 first free cells' speed over the top and under the bottom, where a reversed layer shows; the pressure's load
-along the chord) to ``--out``.  ``--cells-per-chord`` and ``--background-coarsening`` replace the preset's
-body grid spacing and the background's coarsening on the preset's domain (a grid study beyond ``fine``, or the
-background's share), and the JSON keeps the lift's record (``C_L_record``, one value per 0.1 B/V) so that the
-settling of the mean shows.
+along the chord) to ``--out``.
+``--cells-per-chord``, ``--background-coarsening`` and ``--body-margin`` replace the preset's body grid spacing,
+the background's coarsening and how far the body grid reaches beyond the deck, on the preset's domain (a grid
+study beyond ``fine``, or the background's share), and the JSON keeps the lift's record (``C_L_record``, one
+value per 0.1 B/V) so that the settling of the mean shows.
 """
 
 from __future__ import annotations
@@ -282,6 +284,9 @@ def main(argv=None) -> int:
                     help="the body grid's cells per chord (default the preset's: 16 / 40 / 80)")
     ap.add_argument("--background-coarsening", type=int, default=None,
                     help="the background's cells this many times the body grid's (default the preset's 2)")
+    ap.add_argument("--body-margin", type=float, default=None,
+                    help="chords the body grid reaches beyond the deck (default the preset's 0.35; at least 6 "
+                         "background cells)")
     ap.add_argument("--section", choices=SECTIONS, default="great_belt",
                     help="the Great Belt deck (default) or a flat plate 2 %% of the chord thick (the control; "
                          "hold it at --angle 0)")
@@ -306,6 +311,8 @@ def main(argv=None) -> int:
              args.cells_per_chord is None or 8 <= args.cells_per_chord <= 2000, "8 to 2000"),
             ("--background-coarsening", args.background_coarsening,
              args.background_coarsening is None or 1 <= args.background_coarsening <= 16, "1 to 16"),
+            ("--body-margin", args.body_margin,
+             args.body_margin is None or 0.05 <= args.body_margin <= 5.0, "0.05 to 5 chords"),
             ("--threads", args.threads, args.threads is None or args.threads >= 1, ">= 1"),
             ("--nose-height", args.nose_height, args.nose_height is None or 0.0 < args.nose_height <= 1.0, "(0, 1]"),
             ("--bottom-flat", args.bottom_flat, args.bottom_flat is None or 0.0 <= args.bottom_flat < 1.0, "[0, 1)")):
@@ -319,6 +326,8 @@ def main(argv=None) -> int:
             q = replace(q, cells_per_chord=args.cells_per_chord)
         if args.background_coarsening is not None:
             q = replace(q, background_coarsening=args.background_coarsening)
+        if args.body_margin is not None:
+            q = replace(q, body_margin=args.body_margin)
         for option, value in (("--nose-height", args.nose_height), ("--bottom-flat", args.bottom_flat)):
             if value is not None and args.section != "great_belt":
                 raise InputError(option, value, "applies to --section great_belt only")
@@ -331,6 +340,7 @@ def main(argv=None) -> int:
               "bottom_flat_fraction": args.bottom_flat, "angle_deg": args.angle,
               "speed_m_s": args.speed, "reynolds": q.reynolds, "quality": args.quality,
               "cells_per_chord": q.cells_per_chord, "background_coarsening": q.background_coarsening,
+              "body_margin": q.body_margin,
               "sst_walls": args.sst_walls, "duration": args.duration, **got}
     print(f"{args.section} at {args.angle:g} deg, Re {q.reynolds:.3g}, {args.quality} "
           f"({q.cells_per_chord} cells per chord, background x{q.background_coarsening}), "

@@ -23,7 +23,8 @@ from cfd_helpers import load_tool
                                           (["--bottom-flat", "-0.1"], "--bottom-flat"),
                                           (["--section", "plate", "--bottom-flat", "0.3"], "--bottom-flat"),
                                           (["--cells-per-chord", "4"], "--cells-per-chord"),
-                                          (["--background-coarsening", "0"], "--background-coarsening")])
+                                          (["--background-coarsening", "0"], "--background-coarsening"),
+                                          (["--body-margin", "0"], "--body-margin")])
 def test_bad_input_exits_2_naming_the_option_and_writes_nothing(tmp_path, capsys, argv, option):
     tool = load_tool("deck_layer")
     out = tmp_path / "layer"
@@ -118,13 +119,14 @@ def test_a_short_run_reads_the_layer_over_the_top(tmp_path):
     tool = load_tool("deck_layer")
     out = tmp_path / "layer"
     assert tool.main(["--duration", "2", "--threads", "1", "--cells-per-chord", "12", "--background-coarsening", "3",
-                      "--out", str(out)]) == 0
+                      "--body-margin", "2", "--out", str(out)]) == 0
     got = json.loads((out / "layer.json").read_text())
     # the grid as asked, not the preset's 16 cells per chord over a background of 8: the background's cells are
-    # 1/4 chord, and the body grid, reaching 6 of them (1.5 B) beyond the deck, moves the inflow from 3 to 4 chords
-    # upstream: 4 + 20 chords at 4 cells
-    assert got["cells_per_chord"] == 12 and got["background_coarsening"] == 3
-    assert got["grids"].startswith("96 x ")
+    # 1/4 chord, and the body grid, reaching 2 B beyond the deck (1 + 2 x 2 chords at 12 cells, 2.5 chords upstream
+    # of the deck's centre), moves the inflow from 3 to 4.5 chords upstream (8 background cells clear of it):
+    # 4.5 + 20 chords at 4 cells
+    assert got["cells_per_chord"] == 12 and got["background_coarsening"] == 3 and got["body_margin"] == 2.0
+    assert got["grids"].startswith("98 x ") and " body 60 x " in got["grids"]
     record = np.array(got["C_L_record"])             # one value per 0.1 B/V, t = 0 to 2
     assert record.shape == (21,) and np.isfinite(record).all()
     assert abs(record[11:].mean() - got["C_L"]) < 0.01   # the second half's mean, from every step: the same lift
