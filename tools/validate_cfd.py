@@ -12,7 +12,7 @@ Reported: C_D = 2 F_x/(rho U^2 D) (mean over whole shedding periods when unstead
 recirculation length L_w/D (last zero of u on the wake centreline, from the rear of the cylinder),
 Strouhal number from the zero up-crossings of C_L over the last ``--window`` time units.
 DFG 2D-2 (``dfg2``): the same channel with U_max = 1.5 (Re 100, periodic shedding): c_D,max, c_L,max
-and St = f D / U_mean over the last ``--window`` (at most half the run), the force series written next
+and St = f D / U_mean over the last ``--window`` (at most half of ``--t-end``), the force series written next
 to ``--out`` as dfg2_ppd<N>[_bg<M>].h5 and .png. ``--overset BG_PPD`` (dfg, dfg2, heave): the body in a
 body grid of h = D/ppd spanning +-1 D (``bridge.cfd.OversetPair``) over a background of h = D/BG_PPD.
 ``--save-state FILE`` (dfg2 --overset, one --ppd) keeps the background's flow at the end of the run in HDF5;
@@ -324,7 +324,7 @@ def dfg(ppd, t_end, threads, scheme, ib_order=1, ny_shift=0, overset=None, body_
         run(sim, t_end, monitors)
         t, f = hist.array()
         f = f[:, 0, :]
-        probe, centre, cells, steps = sim, (0.2, 0.2), nx * ny, sim.n_steps
+        probe, centre, cells, steps, t_start = sim, (0.2, 0.2), nx * ny, sim.n_steps, 0.0
     else:
         sh = body_shift * d / ppd
         n, e = int(round(2 * body_extent * ppd)), body_extent * d
@@ -350,8 +350,6 @@ def dfg(ppd, t_end, threads, scheme, ib_order=1, ny_shift=0, overset=None, body_
     def phi(x, y):
         return np.hypot(x - centre[0], y - centre[1]) - d / 2
 
-    if overset is None:
-        t_start = 0.0
     dp, dp_linear = (_line_pressure(probe, centre[0] - d / 2, -1, centre[1], phi, n)
                      - _line_pressure(probe, centre[0] + d / 2, +1, centre[1], phi, n) for n in (3, 2))
     if unsteady:
