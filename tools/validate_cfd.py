@@ -388,9 +388,7 @@ def save_background(pair, path, attrs) -> None:
 
     buf = io.BytesIO()
     with h5py.File(buf, "w") as fh:
-        group = fh.create_group("background")
-        pair.background.state.t, pair.background.state.n_steps = pair.background.t, pair.background.n_steps
-        pair.background.state.save(group)
+        pair.background.state.save(fh.create_group("background"))   # the state holds the grid's t and n_steps
         for key, value in attrs.items():
             fh.attrs[key] = value
     atomic_write_bytes(Path(path), buf.getvalue())
@@ -409,8 +407,8 @@ def load_background(pair, path) -> None:
     import h5py
 
     with h5py.File(path, "r") as fh:
-        pair.background.state.load(fh["background"])
-    pair.background.t, pair.background.n_steps = pair.background.state.t, 0
+        pair.background.state.load(fh["background"])   # t with it (Simulation.t is the state's)
+    pair.background.n_steps = 0   # the restarted run counts its own steps
 
 
 def _write_series(stem: Path, t, cd, cl, row) -> None:
