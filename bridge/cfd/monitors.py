@@ -63,7 +63,9 @@ class ProgressNote:
         now = time.perf_counter()
         if self._start is None:
             self._start = (now, sim.t)
-            self._step = self.fraction * max(self.t_end - sim.t, 1e-300)
+            # nothing left (a run resumed at its end): steps of the whole run, which _next can move by
+            remaining = self.t_end - sim.t
+            self._step = self.fraction * (remaining if remaining > 1e-9 * self.t_end else self.t_end)
             self._next = sim.t + self._step
         if sim.t < self._next:
             return

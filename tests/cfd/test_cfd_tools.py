@@ -46,6 +46,10 @@ def test_progress_note_writes_a_line_per_fraction_with_the_time_left():
     out = lines.getvalue().splitlines()
     assert [line.split(" of ")[0] for line in out] == ["case: t = 1.4", "case: t = 1.6", "case: t = 1.8",
                                                        "case: t = 2"], out
+    # first called with nothing left (a run resumed at its end): it returns (it looped for ever before) and is quiet
+    lines = io.StringIO()
+    ProgressNote("case", 2.0, stream=lines)(SimpleNamespace(t=2.0, n_steps=7))
+    assert lines.getvalue() == ""
 
 
 def test_validate_cfd_runs_tiny(tmp_path, capsys):
