@@ -1,4 +1,5 @@
-"""Ctrl-C on the command line: one line and exit status 130, wherever it lands.
+"""Ctrl-C on the command line: one line and exit status 130, wherever it lands; SIGTERM (what a batch
+system or a CI time-out sends) is handled the same way, with exit status 143.
 
 Three moments need care:
 
@@ -11,6 +12,8 @@ Three moments need care:
 * at the exit: :func:`exit_command` leaves at once with 130 after the report, so that nothing the
   interrupt left half-done (an import, a clean-up) can turn the exit into a death by SIGINT (seen about
   0.25 s after start, exit status -2).
+Worker processes are stopped on the way out (:mod:`bridge.workers`), and end by themselves if the program
+is killed outright.
 Only the standard library is imported here: this module loads before everything else.
 """
 
@@ -23,57 +26,76 @@ import sys
 import threading
 import time
 
-__all__ = ["Interrupts", "stop_quietly_while_loading", "exit_command", "INTERRUPTED"]
+__all__ = ["Interrupts", "stop_quietly_while_loading", "exit_command", "INTERRUPTED", "TERMINATED"]
 
-INTERRUPTED = 130  # the shell's convention: 128 + SIGINT
+INTERRUPTED = 128 + signal.SIGINT    # 130, the shell's convention
+TERMINATED = 128 + signal.SIGTERM    # 143
+_WORDS = {signal.SIGINT: "interrupted", signal.SIGTERM: "terminated (SIGTERM)"}
 
 
 def stop_quietly_while_loading() -> None:
-    """Until the command installs :class:`Interrupts`: Ctrl-C prints one line and exits with 130."""
-    signal.signal(signal.SIGINT, lambda *_: (print("interrupted; nothing written", file=sys.stderr),
-                                             os._exit(INTERRUPTED)))
+    """Until the command installs :class:`Interrupts`: Ctrl-C (or SIGTERM) prints one line and exits with
+    130 (143)."""
+    for signum in _WORDS:
+        signal.signal(signum, lambda n, _: (print(f"{_WORDS[n]}; nothing written", file=sys.stderr),
+                                            os._exit(128 + n)))
 
 
 def exit_command(status: int) -> None:
     """End the process with ``status``; after an interruption, at once (see the module docstring)."""
-    if status == INTERRUPTED:
+    if status in (INTERRUPTED, TERMINATED):
+        # the semaphores of a worker pool's queues unregister themselves from the resource tracker before
+        # the hard exit, as at a normal exit (multiprocessing's own exit hook runs these finalisers), else the
+        # tracker warns of them as "leaked"
+        mp_util = sys.modules.get("multiprocessing.util")
+        if mp_util is not None:
+            with contextlib.suppress(Exception):
+                mp_util._run_finalizers(0)
         sys.stdout.flush()
         sys.stderr.flush()
-        os._exit(INTERRUPTED)
+        os._exit(status)
     sys.exit(status)
 
 
 class Interrupts:
-    """While active, SIGINT sets ``fired`` before raising KeyboardInterrupt, so an exception that the
-    interrupt caused elsewhere (a library turning it into an ImportError half-way through an import,
-    say) is still reported as the interruption it was.
+    """While active, SIGINT and SIGTERM set ``fired`` before raising KeyboardInterrupt, so an exception that
+    the interrupt caused elsewhere (a library turning it into an ImportError half-way through an import,
+    say) is still reported as the interruption it was, and the clean-up of ``finally`` and ``except``
+    blocks (workers stopped, temporary files removed) runs for both.
     """
 
     def __init__(self):
         self.fired = False
+        self.signum = signal.SIGINT     # the first signal received (its exit status is 128 + signum)
         self.finished = False
         self._previous = None
+        self._previous_term = None
         self._hook = None
         self._in_hook = False        # the unraisable hook is running (see _handler)
         self._delivered = False      # the handler has raised KeyboardInterrupt in the main flow
         self._redelivering = False
 
     def finish(self) -> None:
-        """The interruption is being reported: further Ctrl-C (or one re-delivered late) is ignored, so
-        the exit status stays 130."""
+        """The interruption is being reported: further Ctrl-C or SIGTERM (or one re-delivered late) is
+        ignored, so the exit status stays 130 (143)."""
         self.finished = True
         with contextlib.suppress(ValueError):
-            signal.signal(signal.SIGINT, signal.SIG_IGN)
+            for signum in _WORDS:
+                signal.signal(signum, signal.SIG_IGN)
 
     def reported(self, message) -> int:
         """After an exception: if it came from the interrupt, print ``message()`` (one line: what was
-        kept) and return the exit status 130; otherwise re-raise it.  Call from an ``except
+        kept; it starts with "interrupted", which is replaced by "terminated (SIGTERM)" after SIGTERM) and
+        return the exit status 130 (143 after SIGTERM); otherwise re-raise it.  Call from an ``except
         BaseException`` block."""
         if not self.fired:
             raise
         self.finish()
-        print(message(), file=sys.stderr)
-        return INTERRUPTED
+        text = message()
+        if self.signum != signal.SIGINT and text.startswith("interrupted"):
+            text = _WORDS[self.signum] + text[len("interrupted"):]
+        print(text, file=sys.stderr)
+        return 128 + self.signum
 
     def _redeliver(self) -> None:
         """Send SIGINT again until the handler has raised it in the main flow (a signal that lands while
@@ -94,6 +116,8 @@ class Interrupts:
             threading.Thread(target=self._redeliver, daemon=True).start()
 
     def _handler(self, signum, frame):
+        if not self.fired:
+            self.signum = signum
         self.fired = True
         if self._in_hook:   # raised here, Python would swallow it like the first one: deliver it later
             self._redeliver_soon()
@@ -118,7 +142,8 @@ class Interrupts:
     def __enter__(self):
         try:
             self._previous = signal.signal(signal.SIGINT, self._handler)
-        except ValueError:  # not the main thread (e.g. called from a worker): leave SIGINT alone
+            self._previous_term = signal.signal(signal.SIGTERM, self._handler)
+        except ValueError:  # not the main thread (e.g. called from a worker): leave the signals alone
             self._previous = None
             return self
         self._hook, sys.unraisablehook = sys.unraisablehook, self._unraisable
@@ -128,5 +153,6 @@ class Interrupts:
         self.finished = True
         if self._previous is not None:
             signal.signal(signal.SIGINT, self._previous)
+            signal.signal(signal.SIGTERM, self._previous_term)
             sys.unraisablehook = self._hook
         return False

@@ -24,7 +24,6 @@ if __name__ == "__main__":
     stop_quietly_while_loading()
 
 import argparse
-import contextlib
 import itertools
 import json
 import math
@@ -34,7 +33,7 @@ import signal
 import tempfile
 import time
 from collections.abc import Sequence
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import as_completed
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -44,6 +43,7 @@ import numpy as np
 from .config import check_name, load_scenario
 from .errors import ConvergenceError, InputError
 from .interrupts import Interrupts, exit_command
+from .workers import worker_pool
 
 __all__ = ["Case", "plan_cases", "run_case", "run_sweep", "collect", "main"]
 
@@ -302,30 +302,10 @@ def run_sweep(cases: list[Case], sweep_dir: Path, stages: list[str] | None = Non
     else:
         context = multiprocessing.get_context()
         stopping = context.Event()   # handed to the workers as they start (inheritance, as Event needs)
-        pool = ProcessPoolExecutor(max_workers=workers, mp_context=context,
-                                   initializer=_worker_start, initargs=(stopping,))
-        futs = []
-        try:
+        with worker_pool(workers, context, _worker_start, (stopping,), stopping) as pool:
             futs = [pool.submit(run_case, c, str(cases_dir), stages, quick, cache) for c in cases]
             for fut in as_completed(futs):
                 report(*fut.result())
-        except KeyboardInterrupt:
-            stopping.set()
-            for f in futs:
-                f.cancel()
-            for child in multiprocessing.active_children():  # a Ctrl-C sent to us alone reaches them too
-                if child.pid is not None:
-                    with contextlib.suppress(OSError):
-                        os.kill(child.pid, signal.SIGINT)
-            try:
-                pool.shutdown(wait=True, cancel_futures=True)
-            finally:
-                # an interrupt inside submit() (workers forked, the pool's manager not yet running) leaves
-                # workers that ignore SIGINT and wait on the pool's pipes for ever: end them
-                for child in multiprocessing.active_children():
-                    child.terminate()
-            raise
-        pool.shutdown(wait=True)
     return status
 
 

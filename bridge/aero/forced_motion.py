@@ -22,7 +22,6 @@ uninterrupted run (the step is a one-step scheme whose only state is those array
 
 from __future__ import annotations
 
-import contextlib
 import hashlib
 import json
 import math
@@ -440,7 +439,9 @@ def run_cases(shape, jobs, quality: Quality, checkpoint_every: int = 2000,
     checkpoint) and its error is raised here; so is Ctrl-C, which the running cases receive too."""
     import multiprocessing
     import queue as queues
-    from concurrent.futures import FIRST_EXCEPTION, ProcessPoolExecutor, wait
+    from concurrent.futures import FIRST_EXCEPTION, wait
+
+    from bridge.workers import worker_pool
 
     workers = default_workers() if workers is None else workers
     if workers <= 1 or len(jobs) < 2:
@@ -459,33 +460,21 @@ def run_cases(shape, jobs, quality: Quality, checkpoint_every: int = 2000,
             if progress is not None:
                 progress(line)
 
-    pool = ProcessPoolExecutor(max_workers=min(workers, len(jobs)), mp_context=context,
-                               initializer=_case_worker_start, initargs=(lines, stopping))
-    futures = []
-    try:
-        futures = [pool.submit(_case_in_worker, shape, case, quality, ckpt, checkpoint_every, label)
-                   for case, ckpt, label in jobs]
-        pending = set(futures)
-        while pending:
-            done, pending = wait(pending, timeout=0.5, return_when=FIRST_EXCEPTION)
+    with worker_pool(min(workers, len(jobs)), context, _case_worker_start, (lines, stopping), stopping) as pool:
+        try:
+            futures = [pool.submit(_case_in_worker, shape, case, quality, ckpt, checkpoint_every, label)
+                       for case, ckpt, label in jobs]
+            pending = set(futures)
+            while pending:
+                done, pending = wait(pending, timeout=0.5, return_when=FIRST_EXCEPTION)
+                drain()
+                for f in done:
+                    f.result()   # a failed case: raise its error now (worker_pool stops the others)
             drain()
-            for f in done:
-                f.result()   # a failed case: raise its error now (the handler below stops the others)
-        drain()
-        records = [f.result() for f in futures]
-    except BaseException:
-        stopping.set()
-        for f in futures:
-            f.cancel()
-        for child in multiprocessing.active_children():   # the running cases stop cleanly (as bridge.sweep)
-            if child.pid is not None:
-                with contextlib.suppress(OSError):
-                    os.kill(child.pid, signal.SIGINT)
-        pool.shutdown(wait=True, cancel_futures=True)
-        drain()
-        raise
-    pool.shutdown(wait=True)
-    return records
+        except BaseException:
+            drain()
+            raise
+    return [f.result() for f in futures]
 
 
 def _march(flow, polys, case, q, checkpoint, checkpoint_every, progress, label, observe=None) -> ForceRecord:
