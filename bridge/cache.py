@@ -11,11 +11,17 @@ Each stage's output is stored under a key, the SHA-256 of everything the result 
 * the keys of the upstream stages it reads (a key fixes its output: same inputs, same code);
 * the run options that change results (``quick``, ``quality``).
 
-A stored entry is a folder ``<cache>/<stage>/<key>/`` with ``output.pkl`` (summary, report, the stage's
-HDF5 group as a file image, its figures as PNG bytes, and the Python result object that later stages
-read).  Entries are written to a temporary folder and renamed into place: a reader sees a whole entry
-or none.  Delete the cache folder at any time; it only costs the recomputation.  Pickle is used for
-the result objects: the cache is the user's own folder, never a file from elsewhere.
+A stored entry is one HDF5 file ``<cache>/<stage>/<key>/entry.h5`` holding data only, since result
+folders, cache included, travel between people: attributes ``format``, ``stage`` and ``key`` (the entry's
+own), ``summary`` (JSON text), ``report`` (text), ``figures/<file name>`` (the PNG or other file's bytes,
+uint8), ``h5_image`` (the stage's HDF5 group as an HDF5 file image, uint8) and ``data``, the result object
+that later stages read, encoded by :mod:`bridge.datastore` (arrays and JSON; reading instantiates only
+data containers and the result classes of ``bridge``, never code a file names).  Nothing is unpickled.
+An entry that does not read back as this stage's data (damaged, of another format, made for another
+key, or naming a type that is not data) is :class:`UnreadableEntry`: the pipeline says so in one line,
+computes the stage again and replaces the entry.  Entries are written to a temporary folder and renamed
+into place: a reader sees a whole entry or none.  Delete the cache folder at any time; it only costs
+the recomputation.
 """
 
 from __future__ import annotations
@@ -24,7 +30,6 @@ import hashlib
 import io
 import json
 import os
-import pickle
 import shutil
 import tempfile
 from collections.abc import Mapping
@@ -34,13 +39,23 @@ from importlib.util import find_spec
 from pathlib import Path
 from typing import Any
 
-from . import __version__
+from . import __version__, datastore
 from .stages import IDENTITY_FIELDS, STAGES, StageOutput
 
-__all__ = ["stage_key", "store", "load", "save", "StoredGroup", "CACHE_FORMAT"]
+__all__ = ["stage_key", "store", "load", "save", "StoredGroup", "UnreadableEntry", "CACHE_FORMAT", "ENTRY"]
 
-CACHE_FORMAT = "1"  # bump when the entry layout changes
-COMMON_CODE = ("bridge.cache", "bridge.errors", "bridge.results", "bridge.stages")
+CACHE_FORMAT = "2"  # bump when the entry layout changes
+ENTRY = "entry.h5"  # the file of an entry, in its folder <cache>/<stage>/<key>/
+COMMON_CODE = ("bridge.cache", "bridge.datastore", "bridge.errors", "bridge.results", "bridge.stages")
+
+
+class UnreadableEntry(Exception):
+    """A stored entry that does not read back as its stage's data; ``path`` is the entry (its file, or
+    its folder when the file is missing), ``reason`` one line on what is wrong."""
+
+    def __init__(self, path: Path, reason: str):
+        super().__init__(f"{path}: {reason}")
+        self.path, self.reason = path, reason
 
 
 @cache
@@ -128,7 +143,7 @@ def _png(fig) -> bytes:
 
 def store(output: StageOutput) -> StageOutput:
     """The same output with its figures rendered to PNG bytes and its HDF5 group held as a file image:
-    a self-contained value that can be pickled, cached and written any number of times."""
+    a self-contained value that can be cached and written any number of times."""
     if isinstance(output.write_h5, StoredGroup) and all(isinstance(f, bytes) for f in output.figures.values()):
         return output
     import matplotlib
@@ -144,38 +159,109 @@ def _entry(root: Path, name: str, key: str) -> Path:
 
 
 def load(root: Path, name: str, key: str) -> StageOutput | None:
-    """The stored output of stage ``name`` under ``key``, or None (also for an unreadable entry)."""
-    f = _entry(root, name, key) / "output.pkl"
+    """The stored output of stage ``name`` under ``key``; None when nothing is stored there.
+
+    An entry folder whose ``entry.h5`` is missing or does not read back as this stage's data (any
+    failure to decode it) raises :class:`UnreadableEntry`; :func:`save` with ``replace_unreadable=True``
+    then replaces it.  Any other file in the folder (e.g. an ``output.pkl`` of an older format) is never read.
+    """
+    folder = _entry(root, name, key)
+    if not folder.exists():
+        return None
+    f = folder / ENTRY
     if not f.is_file():
-        return None
+        raise UnreadableEntry(folder, f"no {ENTRY} in it")
     try:
-        with open(f, "rb") as fh:
-            d = pickle.load(fh)
-    except Exception:  # a damaged or foreign entry is a miss, recomputed and replaced
-        return None
-    return StageOutput(summary=d["summary"], write_h5=StoredGroup(d["h5_image"]), report=d["report"],
-                       figures=d["figures"], data=d["data"], from_cache=True)
+        return _read_entry(f, name, key)
+    except Exception as exc:  # a damaged or foreign entry: recomputed and replaced
+        reason = str(exc) if isinstance(exc, datastore.DataError) else f"{type(exc).__name__}: {exc}"
+        raise UnreadableEntry(f, " ".join(reason.split())) from None
 
 
-def save(root: Path, name: str, key: str, output: StageOutput) -> None:
-    """Keep ``output`` (made self-contained by :func:`store`) under ``key``; an existing entry stays."""
+def _read_entry(f: Path, name: str, key: str) -> StageOutput:
+    import h5py
+
+    member = datastore.member
+    def text(group, member_name: str) -> str:
+        ds = member(group, member_name, h5py.Dataset)
+        if ds.shape != () or ds.dtype.kind not in "OS":
+            raise datastore.DataError(f"{member_name}: not text")
+        raw = ds[()]
+        return raw.decode() if isinstance(raw, bytes) else str(raw)
+
+    def octets(ds) -> bytes:
+        if ds.dtype != "uint8" or ds.ndim != 1:
+            raise datastore.DataError(f"{ds.name}: not bytes (uint8)")
+        return ds[()].tobytes()
+
+    with h5py.File(f, "r") as h5:
+        fmt, stage, made_for = (h5.attrs.get(k) for k in ("format", "stage", "key"))
+        if (fmt, stage, made_for) != (CACHE_FORMAT, name, key):
+            raise datastore.DataError(f"an entry of format {fmt!r} for the stage {stage!r} under the key "
+                                      f"{str(made_for)[:12]!r}..., not of format {CACHE_FORMAT!r} for this one")
+        summary = json.loads(text(h5, "summary"))
+        if type(summary) is not dict or not all(type(v) in (float, int, bool, str, type(None))
+                                                for v in summary.values()):
+            raise datastore.DataError("summary: not a table of numbers, flags and text")
+        report = text(h5, "report")
+        figures_group = member(h5, "figures", h5py.Group)
+        figures = {fig: octets(member(figures_group, fig, h5py.Dataset)) for fig in figures_group}
+        image = octets(member(h5, "h5_image", h5py.Dataset))
+        data = datastore.read(member(h5, "data", h5py.Group))
+    return StageOutput(summary=summary, write_h5=StoredGroup(image), report=report, figures=figures, data=data,
+                       from_cache=True)
+
+
+def _write_entry(f: Path, name: str, key: str, output: StageOutput) -> None:
+    import h5py
+    import numpy as np
+
+    with h5py.File(f, "w") as h5:
+        h5.attrs.update({"format": CACHE_FORMAT, "stage": name, "key": key})
+        h5["summary"] = json.dumps(output.summary, default=_plain)
+        h5["report"] = output.report
+        figures = h5.create_group("figures", track_order=True)
+        for fig, content in output.figures.items():
+            figures[fig] = np.frombuffer(content, dtype=np.uint8)
+        h5["h5_image"] = np.frombuffer(output.write_h5.image, dtype=np.uint8)
+        datastore.write(h5.create_group("data"), output.data)
+
+
+def _plain(value: Any) -> Any:
+    """A numpy number of a summary as the Python number it is."""
+    if hasattr(value, "item") and getattr(value, "shape", None) == ():
+        return value.item()
+    raise TypeError(f"summary value {value!r} of type {type(value).__name__} is not a number, flag or text")
+
+
+def save(root: Path, name: str, key: str, output: StageOutput, replace_unreadable: bool = False) -> None:
+    """Keep ``output`` (made self-contained by :func:`store`) under ``key``.  An existing entry stays,
+    unless ``replace_unreadable`` (it was :class:`UnreadableEntry`): then the new one takes its place.
+    Data that cannot be stored (:mod:`bridge.datastore`) is a :class:`bridge.datastore.DataError`, and
+    nothing is kept."""
     from .files import folder_mode
 
     final = _entry(root, name, key)
-    if final.exists():
+    if final.exists() and not replace_unreadable:
         return
     final.parent.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(dir=final.parent, prefix=f".{key[:12]}.", suffix=".tmp"))
     try:
-        output = store(output)
-        with open(tmp / "output.pkl", "wb") as fh:
-            pickle.dump({"summary": output.summary, "report": output.report, "figures": output.figures,
-                         "h5_image": output.write_h5.image, "data": output.data}, fh, protocol=pickle.HIGHEST_PROTOCOL)
+        _write_entry(tmp / ENTRY, name, key, store(output))
         os.chmod(tmp, folder_mode())
+        aside = None
+        if final.exists():   # replace: move the unreadable entry out of the way, then put the new one there
+            aside = Path(tempfile.mkdtemp(dir=final.parent, prefix=f".{key[:12]}.", suffix=".replaced.tmp"))
+            try:
+                os.replace(final, aside / "entry")
+            except OSError:  # another process moved it first
+                pass
         try:
             os.replace(tmp, final)
         except OSError:  # another process stored the same entry first: keep theirs
             shutil.rmtree(tmp, ignore_errors=True)
+        if aside is not None:
+            shutil.rmtree(aside, ignore_errors=True)
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise

@@ -20,7 +20,7 @@ the thesis's (u, p positive up; theta, m nose-up; moment about mid-chord), see
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Protocol
+from typing import Any, Protocol
 
 import numpy as np
 from scipy.special import hankel2
@@ -154,6 +154,14 @@ class WithLateral:
         self.filled = tuple(n for n in LATERAL if n not in getattr(base, "provides", VERTICAL_TORSIONAL))
         self.name = f"{base.name} + quasi-steady lateral" if self.filled else base.name
         self.provides = tuple(dict.fromkeys((*getattr(base, "provides", VERTICAL_TORSIONAL), *self.filled)))
+
+    def data_arguments(self) -> dict[str, Any]:
+        """The constructor's arguments, for the stage cache (:mod:`bridge.datastore`)."""
+        return {"base": self.base, "lateral": self.lateral}
+
+    @classmethod
+    def from_data_arguments(cls, arguments: dict[str, Any]) -> WithLateral:
+        return cls(**arguments)
 
     @property
     def omega_range(self) -> tuple[float, float]:
