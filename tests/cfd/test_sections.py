@@ -11,6 +11,7 @@ from bridge.cfd import BoundaryConditions, CartesianGrid, FlowConfig, Simulation
 from bridge.cfd.sections import (
     SECTIONS,
     FlatPlate,
+    PolygonSection,
     Rectangle,
     StreamlinedBox,
     great_belt_section,
@@ -26,6 +27,9 @@ EXAMPLES = {
     "streamlined_box": [great_belt_section(), StreamlinedBox(nose_height_fraction=1.0),
                         StreamlinedBox(cross_fall=0.0, bottom_flat_fraction=0.3, top_flat_fraction=1.0),
                         StreamlinedBox(railings=True)],
+    # a symmetric hexagon in its own coordinates (tests/cfd/test_polygon_sections.py has the asymmetric decks)
+    "polygon": [PolygonSection(vertices=[[0.0, 2.0], [4.0, 0.0], [16.0, 0.0], [20.0, 2.0], [16.0, 4.0], [4.0, 4.0],
+                                         [0.0, 2.0]])],
 }
 ALL = [pytest.param(s, id=f"{name}-{i}") for name, ss in EXAMPLES.items() for i, s in enumerate(ss)]
 
@@ -104,7 +108,7 @@ def test_outline_is_simple_counter_clockwise_and_spans_chord_and_depth(section):
 
 @pytest.mark.parametrize("section", ALL)
 def test_outline_is_symmetric_fore_and_aft(section):
-    """All three sections (the Great Belt girder too) are symmetric about x = 0."""
+    """The shipped sections (the Great Belt girder too) and the polygon example are symmetric about x = 0."""
     v = np.vstack([p.vertices for p in section.polygons()])
     mirrored = v * np.array([-1.0, 1.0])
     key = lambda a: a[np.lexsort((a[:, 1], a[:, 0]))]  # noqa: E731
