@@ -5,7 +5,9 @@ Two forms exist:
 
 * a full bridge (``scenarios/great_belt.toml``): every input of the thesis, sections 1.4, 3.2, Table 3.1-3.4;
 * an up-scaled bridge (``scenarios/model_c.toml``): ``reference = "great_belt"`` and ``main_span_m = 4000``;
-  the up-scaled inputs are computed by :mod:`bridge.upscaling` (thesis 1.5), never typed in.
+  the up-scaled inputs are computed by :mod:`bridge.upscaling` (thesis 1.5), never typed in.  Any table of
+  such a file changes the reference's inputs key by key before the up-scaling (``[girder] width_m = 40.0``;
+  :func:`load_scenario`).
 
 Two more kinds run the flutter stage alone: ``kind = "section"``, a 2-DOF sectional model (a
 ``[section]`` table, :mod:`bridge.flutter.section`), and ``kind = "modal"``, modes given directly (a
@@ -20,6 +22,7 @@ stored twice.
 from __future__ import annotations
 
 import math
+import os
 import re
 import tomllib
 from collections.abc import Mapping
@@ -31,7 +34,9 @@ from .errors import InputError, check_range
 
 __all__ = [
     "Material", "BoxSection", "Geometry", "Girder", "Cable", "Hanger", "Pylon", "DampingEntry", "Air",
-    "Scenario", "load_scenario", "scenario_path", "check_name", "SCENARIO_DIR", "GRAVITY_M_S2",
+    "Scenario", "load_scenario", "scenario_path", "check_name", "SCENARIO_DIR", "GRAVITY_M_S2", "with_aerodynamics",
+    "AERODYNAMIC_CHOICES",
+    "check_deck_chord", "flutter_deck_width", "CHORD_TOLERANCE",
 ]
 
 GRAVITY_M_S2 = 9.81  # the thesis's value (Eq 1.2, 2.3)
@@ -450,7 +455,8 @@ def _parse_optional_tables(t: _Table, scenario: Scenario) -> Scenario:
     if "deck_section" in t.data:
         from .cfd.sections import section_from_mapping
 
-        updates["deck_section"] = section_from_mapping(t.raw("deck_section"), "deck_section")
+        folder = Path(scenario.source_path).parent if scenario.source_path else None  # of a relative outline_path
+        updates["deck_section"] = section_from_mapping(t.raw("deck_section"), "deck_section", base_dir=folder)
     if "aero" in t.data:
         from .aero.options import AeroOptions
 
@@ -503,24 +509,136 @@ def apply_overrides(data: dict, overrides: Mapping[str, Any]) -> dict:
     return data
 
 
-def load_scenario(name_or_path: str | Path, main_span_m: float | None = None,
-                  overrides: Mapping[str, Any] | None = None, _seen: tuple = ()) -> Scenario:
-    """Read, validate and (if the file names a reference) up-scale a scenario.
+# How far the CFD section's chord may differ from the structure's deck width B: the aero stage's derivatives are
+# per the chord and the flutter stage uses them per B, so the two must be one length (a drawing's rounding).
+CHORD_TOLERANCE = 0.01
 
-    ``main_span_m`` overrides the file's main span (command line ``--main-span``): the reference bridge
-    is then up-scaled to it with the rules of thesis 1.5.  ``overrides`` sets dotted input keys before
-    validation (for sweeps); for an up-scaled bridge they apply to its reference bridge's inputs.
-    """
-    path = scenario_path(name_or_path)
+
+def flutter_deck_width(scenario: Scenario) -> tuple[float | None, str]:
+    """The deck width B the flutter stage normalises the aerodynamics with, and the key that gives it
+    (None for a scenario that has none)."""
+    if scenario.kind == "section" and scenario.section is not None:
+        return float(scenario.section.deck_width_m), "section.deck_width_m"
+    if scenario.kind == "modal" and scenario.modal is not None:
+        return float(scenario.modal.deck_width_m), "modal.deck_width_m"
+    if scenario.girder is not None:
+        return float(scenario.girder.width_m), "girder.width_m"
+    return None, ""
+
+
+def check_deck_chord(scenario: Scenario, section: Any = None) -> None:
+    """InputError unless the CFD's deck section (``section``, default the scenario's ``[deck_section]``) has
+    the chord of the structure's deck width, within :data:`CHORD_TOLERANCE`."""
+    section = section if section is not None else scenario.deck_section
+    width, key = flutter_deck_width(scenario)
+    if section is None or width is None:
+        return
+    chord = float(section.chord_m)
+    if abs(chord - width) > CHORD_TOLERANCE * width:
+        given = "deck_section.chord_m" if scenario.deck_section is not None else "deck_section"
+        what = chord if scenario.deck_section is not None else f"not given: the Great Belt box, B = {chord:g} m"
+        raise InputError(given, what, f"the CFD section's chord must equal {key} = {width:g} m (within "
+                         f"{100 * CHORD_TOLERANCE:g} %): the derivatives the CFD gives are per its chord, and the "
+                         "flutter stage applies them per the deck width")
+
+
+def _checked(scenario: Scenario) -> Scenario:
+    """Checks across tables, once every table is read: the CFD section's chord against the deck width."""
+    check_deck_chord(scenario)
+    return scenario
+
+
+# The keys of a file that names a reference bridge which are its own, not tables of the reference.
+_REFERENCE_KEYS = ("name", "description", "reference", "main_span_m")
+
+
+def _read_toml(path: Path) -> dict:
     try:
         with open(path, "rb") as fh:
-            data = tomllib.load(fh)
+            return tomllib.load(fh)
     except tomllib.TOMLDecodeError as err:
         raise InputError("scenario", str(path), f"is not valid TOML ({err})") from None
-    overrides = dict(overrides or {})
-    if "reference" not in data and overrides:
-        data = apply_overrides(data, overrides)
-        overrides = {}
+
+
+def _reference_path(ref: Any, where: Path) -> Path:
+    """The file a ``reference = "..."`` names: a file of that name beside the referring one, else a
+    shipped scenario."""
+    if not isinstance(ref, str):
+        raise InputError("reference", ref, "must be the name of a scenario (a string)")
+    beside = where.parent / f"{ref}.toml"
+    return beside if beside.is_file() else scenario_path(ref)
+
+
+def _rebase_paths(table: Any, source: Path, target: Path) -> Any:
+    """A table read from ``source`` for a scenario whose file is ``target``: its relative ``*_path`` values
+    re-written so that they still name the same files from ``target``'s folder."""
+    if not isinstance(table, dict) or source.parent.resolve() == target.parent.resolve():
+        return table
+    out = {}
+    for k, v in table.items():
+        if isinstance(v, dict):
+            v = _rebase_paths(v, source, target)
+        elif k.endswith("_path") and isinstance(v, str) and not Path(v).is_absolute():
+            v = os.path.relpath(source.parent.resolve() / v, target.parent.resolve())
+        out[k] = v
+    return out
+
+
+def _merge_tables(base: dict, own: Mapping[str, Any]) -> dict:
+    """``own``'s tables laid over ``base``'s, key by key (a value that is a table merges into the table of the
+    same name; any other value replaces).  A ``[deck_section]`` that names its ``shape`` is a section of its
+    own and replaces the reference's whole (one without ``shape`` changes the reference's keys)."""
+    out = dict(base)
+    for k, v in own.items():
+        b = out.get(k)
+        whole = k == "deck_section" and isinstance(v, dict) and "shape" in v
+        out[k] = _merge_tables(b, v) if isinstance(v, dict) and isinstance(b, dict) and not whole else v
+    return out
+
+
+def _resolved_reference(path: Path, seen: tuple[str, ...]) -> tuple[dict, str]:
+    """The raw tables of the full bridge a file describes - its own, or those of its reference (and of the
+    reference's reference...) with the file's tables laid over them - and the bridge's name."""
+    data = _read_toml(path)
+    if "reference" not in data:
+        kind = data.get("kind", "suspension_bridge")
+        if kind != "suspension_bridge":
+            raise InputError("reference", path.stem, f"names a scenario of kind {kind!r}; only a suspension "
+                             "bridge can be a reference")
+        return data, data.get("name", path.stem)
+    ref = data["reference"]
+    if ref in seen:
+        raise InputError("reference", ref, "circular reference between scenario files")
+    ref_path = _reference_path(ref, path)
+    base, _ = _resolved_reference(ref_path, seen + (ref,))
+    base = {k: _rebase_paths(v, ref_path, path) for k, v in base.items()}
+    own = {k: v for k, v in data.items() if k not in _REFERENCE_KEYS}
+    if "kind" in own:
+        raise InputError("kind", own["kind"], "not allowed beside reference = ...: a file that names a reference "
+                         "bridge is a suspension bridge")
+    merged = _merge_tables(base, own)
+    for k in ("name", "description"):
+        merged.pop(k, None)
+    return merged, data.get("name", path.stem)
+
+
+def load_scenario(name_or_path: str | Path, main_span_m: float | None = None,
+                  overrides: Mapping[str, Any] | None = None) -> Scenario:
+    """Read, validate and (if the file names a reference) up-scale a scenario.
+
+    A file with ``reference = "<scenario>"`` is that bridge with the file's own tables laid over the
+    reference's, key by key (``[girder] width_m = 40.0`` changes the girder's width and nothing else;
+    ``[aero]`` and ``[flutter]`` likewise; a ``[deck_section]`` with a ``shape`` is a section of its own), then
+    up-scaled to the file's ``main_span_m``
+    by the rules of thesis 1.5 (:mod:`bridge.upscaling`), applied once, from the full bridge at the end of a
+    chain of references.  ``main_span_m`` overrides the file's main span (command line ``--main-span``).
+    ``overrides`` sets dotted input keys before validation (for sweeps); the key must exist in the file or,
+    for an up-scaled bridge, in the tables it has with its reference.
+    """
+    path = scenario_path(name_or_path)
+    data = _read_toml(path)
+    if "reference" not in data:
+        data = apply_overrides(data, overrides or {})
     t = _Table(data, "")
     if "name" in data:
         name = check_name(t.string("name"))
@@ -528,22 +646,24 @@ def load_scenario(name_or_path: str | Path, main_span_m: float | None = None,
         name = check_name(path.stem, f"name (from the file name {path.name}; rename the file or set name = ...)")
     description = t.string("description", default="")
 
-    if "reference" in data:  # an up-scaled bridge
-        ref = t.string("reference")
-        if ref in _seen:
-            raise InputError("reference", ref, "circular reference between scenario files")
+    if "reference" in data:  # a bridge up-scaled from a reference (or the reference with some inputs changed)
+        t.string("reference")
         span = t.number("main_span_m")
-        reference = load_scenario(path.parent / f"{ref}.toml" if (path.parent / f"{ref}.toml").exists() else ref,
-                                  overrides=overrides, _seen=_seen + (name,))
+        tables, ref_name = _resolved_reference(path, (name,))
+        merged = _Table(apply_overrides(tables, overrides or {}), "")
+        merged.used.add("kind")   # checked by _resolved_reference: a suspension bridge
+        reference = _parse_bridge(merged, ref_name, description, str(path))
+        reference = _parse_optional_tables(merged, reference)
+        merged.done()             # a table name that no parser knows (a typo such as [girdr])
+        t.used.update(data)       # the file's own tables were read through ``merged``
+        t.done()
         target = main_span_m if main_span_m is not None else span
         if main_span_m is not None and not math.isclose(main_span_m, span):
             name = f"{name}_L{main_span_m:g}"
         scenario = reference.with_main_span(target)
         scenario = replace(scenario, name=name, description=description or scenario.description,
                            source_path=str(path))
-        scenario = _parse_optional_tables(t, scenario)
-        t.done()
-        return scenario
+        return _checked(scenario)
 
     kind = t.string("kind", _KINDS, default="suspension_bridge")
     if kind in ("section", "modal"):
@@ -556,14 +676,36 @@ def load_scenario(name_or_path: str | Path, main_span_m: float | None = None,
         if main_span_m is not None:
             raise InputError("--main-span", main_span_m, f"only applies to bridge scenarios, not to kind {kind!r}")
         t.done()
-        return scenario
+        return _checked(scenario)
 
     scenario = _parse_bridge(t, name, description, str(path))
     scenario = _parse_optional_tables(t, scenario)
     t.done()
     if main_span_m is not None and not math.isclose(main_span_m, scenario.geometry.main_span_m):
         scenario = replace(scenario.with_main_span(main_span_m), name=f"{name}_L{main_span_m:g}")
-    return scenario
+    return _checked(scenario)
+
+
+# What --aerodynamics may choose on the command line: the deck's CFD, or a closed form for a quick answer (the
+# table and derivative models need their files, named in the scenario).
+AERODYNAMIC_CHOICES = ("cfd", "theodorsen", "quasi_steady")
+
+
+def with_aerodynamics(scenario: Scenario, aerodynamics: str | None) -> Scenario:
+    """The scenario with the flutter stage's aerodynamics set to ``aerodynamics`` (command line
+    ``--aerodynamics``; None: unchanged), in ``[flutter]`` and, for a sectional model, in ``[section]``."""
+    if aerodynamics is None:
+        return scenario
+    from .flutter.options import FlutterOptions
+
+    try:
+        flutter = replace(scenario.flutter or FlutterOptions(), aerodynamics=aerodynamics)
+        section = scenario.section
+        if scenario.kind == "section" and section is not None and section.aerodynamics is not None:
+            section = replace(section, aerodynamics=aerodynamics)
+    except InputError as err:   # e.g. quasi_steady without [flutter.quasi_steady]
+        raise InputError("--aerodynamics", aerodynamics, f"{err.key} {err.allowed}") from None
+    return replace(scenario, flutter=flutter, section=section)
 
 
 def scenario_fields(obj: Any, include_none: bool = False) -> dict[str, Any]:

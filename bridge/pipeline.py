@@ -12,7 +12,8 @@ from collections.abc import Iterable
 from pathlib import Path
 
 from . import cache
-from .config import Scenario
+from .config import Scenario, check_deck_chord
+from .datastore import DataError
 from .errors import InputError
 from .results import write_results
 from .stages import STAGES, RunOptions, StageOutput, resolve_stage
@@ -64,7 +65,29 @@ def plan_stages(scenario: Scenario, requested: Iterable[str] | None) -> tuple[st
         if name not in allowed:
             raise InputError("--stages", name, f"not available for a scenario of kind {scenario.kind!r} "
                              f"(available: {', '.join(s for s in allowed if s in STAGES)})")
+    if "aero" in needed and scenario.deck_section is None:   # the CFD's deck: the Great Belt box by default
+        from .cfd.sections import great_belt_section
+
+        check_deck_chord(scenario, great_belt_section())
+    if "flutter" in needed:   # a measured table is read now, so that a bad one is found before any stage runs
+        check_aerodynamic_files(scenario)
     return tuple(s for s in STAGES if s in needed)
+
+
+def check_aerodynamic_files(scenario: Scenario) -> None:
+    """Read the aerodynamic table or derivative file the flutter stage will use (``table`` and
+    ``derivatives`` aerodynamics), so that a file that cannot be used is an InputError before any work."""
+    fopts = scenario.flutter
+    aerodynamics = fopts.aerodynamics if fopts is not None else None
+    section = scenario.section if scenario.kind == "section" else None
+    if section is not None and section.aerodynamics is not None:
+        aerodynamics = section.aerodynamics
+    if fopts is None or aerodynamics not in ("table", "derivatives"):
+        return
+    from dataclasses import replace
+
+    base = Path(scenario.source_path).parent if scenario.source_path else None
+    replace(fopts, aerodynamics=aerodynamics).aerodynamic_model(base)
 
 
 def stage_keys(scenario: Scenario, stages: Iterable[str] | None = None,
@@ -94,14 +117,22 @@ def run_stages(scenario: Scenario, stages: Iterable[str] | None = None,
         if options.cache is None:
             outputs[name] = resolve_stage(name)(scenario, outputs, options)
             continue
-        hit = cache.load(options.cache, name, keys[name])
+        try:
+            hit, unreadable = cache.load(options.cache, name, keys[name]), False
+        except cache.UnreadableEntry as bad:   # never trusted: computed again and replaced
+            options.say(f"[{scenario.name}] {name}: the stored result in {bad.path} is not readable as this "
+                        f"stage's data ({bad.reason}); computing it again")
+            hit, unreadable = None, True
         if hit is not None:
             options.say(f"[{scenario.name}] {name}: inputs unchanged, reusing the stored result "
                         f"({options.cache / name / keys[name][:12]}...)")
             outputs[name] = hit
             continue
         out = cache.store(resolve_stage(name)(scenario, outputs, options))
-        cache.save(options.cache, name, keys[name], out)
+        try:
+            cache.save(options.cache, name, keys[name], out, replace_unreadable=unreadable)
+        except DataError as err:   # a result the cache cannot hold as data: the run goes on without storing it
+            options.say(f"[{scenario.name}] {name}: not kept in the stage cache ({err})")
         outputs[name] = out
     return outputs
 

@@ -78,29 +78,52 @@ def _fmt(v: Any, spec: str, unit: str = "") -> str | None:
 
 def headline(summary: Mapping[str, Any]) -> list[str]:
     """The few numbers a user runs the program for, one line each, from the summary keys of the stages
-    that ran: the flutter speed with its frequency and governing modes, the multimode speed and the
+    that ran: the flutter speed with its frequency and governing modes, which aerodynamics gave it and how
+    far to trust them, where the aerodynamic data leave the search blind, the multimode speed and the
     divergence speed; without the flutter stage, the first frequencies or the cable force."""
     s, lines = summary, []
     if "flutter.critical_speed_m_s" in s:
-        vc = _fmt(s.get("flutter.critical_speed_m_s"), ".1f", " m/s")
+        vc_value = s.get("flutter.critical_speed_m_s")
+        vc = _fmt(vc_value, ".1f", " m/s")
         aero = s.get("flutter.aerodynamics")
         aero = f", {aero} aerodynamics" if isinstance(aero, str) else ""
+        blind = s.get("flutter.blind_below_critical")
+        data = _data_range(s)
         if vc is None:
             top = _fmt(s.get("flutter.max_speed_searched_m_s"), ".0f", " m/s") or "the highest speed searched"
-            lines.append(f"no flutter of any mode pair below {top}{aero}")
+            if s.get("flutter.data_span_every_pair", True):
+                lines.append(f"no flutter of any mode pair below {top}{aero}")
+            else:
+                lines.append(f"NO FLUTTER SPEED FOUND, AND NONE RULED OUT below {top}: the aerodynamic data{data} do "
+                             "not span the mode pairs' frequencies at every speed searched"
+                             + (f"; they miss them entirely {blind}" if blind else "")
+                             + " (report.md lists where); widen the reduced velocities")
         else:
             f = _fmt(s.get("flutter.frequency_hz"), ".4f", " Hz")
             om = _fmt(s.get("flutter.reduced_frequency"), ".3f")
             lines.append(f"flutter speed V_c = {vc} at f = {f} (Omega = {om}), governing modes "
                          f"{s.get('flutter.mode_pair')} (two-mode determinant{aero})")
+            if blind:
+                lines.append(f"not searched {blind}: there the aerodynamic data{data} do not reach the modes' "
+                             "frequencies, so a flutter speed there is not ruled out")
+        trust = _trust(s, vc_value)
+        if trust:
+            lines.append(trust)
+        partly = ("no flutter where the data cover the modes, which for some modes is only part of the speeds "
+                  "searched (report.md lists where)")
         if "flutter.multimode_critical_speed_m_s" in s:
             mm = _fmt(s.get("flutter.multimode_critical_speed_m_s"), ".1f", " m/s")
-            lines.append(f"multimode p-k V_c = {mm}" if mm else "multimode p-k: no flutter in the speeds searched")
+            gaps = s.get("flutter.multimode_uncovered")
+            if mm:
+                lines.append(f"multimode p-k V_c = {mm}")
+            else:
+                lines.append(f"multimode p-k: {partly if gaps else 'no flutter in the speeds searched'}")
         if "flutter.multimode_with_lateral_critical_speed_m_s" in s:
             ml = _fmt(s.get("flutter.multimode_with_lateral_critical_speed_m_s"), ".1f", " m/s")
             pct = _fmt(s.get("flutter.multimode_lateral_effect_percent"), "+.1f", " %")
+            none = partly if s.get("flutter.multimode_uncovered") else "no multimode flutter in the speeds searched"
             lines.append(f"with the lateral modes: multimode p-k V_c = {ml}" + (f" ({pct})" if pct else "")
-                         if ml else "with the lateral modes: no multimode flutter in the speeds searched")
+                         if ml else f"with the lateral modes: {none}")
         if "flutter.divergence_speed_m_s" in s:
             dv = _fmt(s.get("flutter.divergence_speed_m_s"), ".1f", " m/s")
             lines.append(f"static divergence at V = {dv}" if dv else "no static divergence in the speeds searched")
@@ -113,6 +136,38 @@ def headline(summary: Mapping[str, Any]) -> list[str]:
                      f"per cable, f_1 estimate (Eq 3.2) "
                      f"{_fmt(s.get('cable.first_vertical_frequency_eq_3_2_hz'), '.4f', ' Hz')}")
     return lines
+
+
+def _data_range(s: Mapping[str, Any]) -> str:
+    lo, hi = s.get("flutter.data_reduced_velocity_min"), s.get("flutter.data_reduced_velocity_max")
+    return f" (U/(fB) {lo:.3g}-{hi:.3g})" if isinstance(lo, float) and isinstance(hi, float) else ""
+
+
+# What each [flutter] aerodynamics option is, for the headline's trust line (the CFD's is its grid study).
+_AERODYNAMICS_IN_WORDS = {
+    "theodorsen": "Theodorsen's thin plate in potential flow, not the deck's own aerodynamics (--aerodynamics cfd "
+                  "runs the deck's CFD)",
+    "quasi_steady": "quasi-steady, from the static coefficients of [flutter.quasi_steady] (no unsteady "
+                    "aerodynamics; --aerodynamics cfd runs the deck's CFD)",
+    "table": "the tabulated frequency response functions given in [flutter] table_path",
+    "derivatives": "the flutter derivatives given in [flutter] derivatives_path",
+}
+
+
+def _trust(s: Mapping[str, Any], vc: Any) -> str:
+    """One line saying which aerodynamics gave V_c and how far to trust them: for the CFD, its preset and
+    the grid error the grid study measured for it (:mod:`bridge.aero.accuracy`), or that none did."""
+    option = s.get("flutter.aerodynamics_option")
+    if option != "cfd":
+        words = _AERODYNAMICS_IN_WORDS.get(option)
+        return f"aerodynamics: {words}" if words else ""
+    quality, study = s.get("aero.quality"), s.get("aero.grid_study") or "no grid study recorded"
+    turbulence = "URANS with k-omega SST" if s.get("aero.turbulence") == "sst" else "laminar Navier-Stokes"
+    line = f"aerodynamics: the deck's own, from forced-motion CFD ({turbulence}, preset '{quality}'); {study}"
+    lo, hi = s.get("aero.vc_grid_error_low_percent"), s.get("aero.vc_grid_error_high_percent")
+    if isinstance(vc, float) and isinstance(lo, float) and isinstance(hi, float):
+        line += f": grid-converged V_c about {vc / (1 - lo / 100):.0f}-{vc / (1 - hi / 100):.0f} m/s"
+    return line
 
 
 def _written_by_us(folder: Path) -> set[str]:

@@ -22,7 +22,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from . import __version__
-from .config import SCENARIO_DIR, load_scenario
+from .config import AERODYNAMIC_CHOICES, SCENARIO_DIR, load_scenario, with_aerodynamics
 from .errors import ConvergenceError, InputError
 from .files import atomic_write_text, check_output_root
 from .interrupts import Interrupts, exit_command
@@ -65,7 +65,8 @@ COMPARISON_ROWS = [
 EXIT_CODES = {0: "done",
               2: "bad input: one line naming the key, the value and the allowed range; nothing written",
               3: "an iteration did not converge (its last residual is printed)",
-              130: "interrupted (Ctrl-C); finished results and cached stages are kept"}
+              130: "interrupted (Ctrl-C); finished results and cached stages are kept",
+              143: "terminated (SIGTERM); as 130"}
 
 
 def comparison_table(summaries: dict[str, dict]) -> str:
@@ -116,10 +117,16 @@ def _parser() -> argparse.ArgumentParser:
                    help="replace the results of an earlier run in OUT/<name>/ (other files there are kept)")
     p.add_argument("--no-cache", action="store_true",
                    help="compute every stage afresh (and do not store them in OUT/.cache/)")
-    p.add_argument("--quick", action="store_true", help="coarse meshes/grids: a fast smoke run")
+    p.add_argument("--quick", action="store_true",
+                   help="coarse meshes and grids everywhere (the FEM, and the CFD's 'tiny' preset): a smoke run "
+                        "whose numbers are not to be used")
     p.add_argument("--quality", choices=("tiny", "quick", "standard", "fine"), default=None,
-                   help="CFD preset of the aero stage (grid, time step, Reynolds number; docs/aero.md); "
-                        "default: the scenario's [aero] quality, tiny with --quick")
+                   help="CFD preset of the aero stage (grid, time step, run length; docs/aero.md); default: the "
+                        "scenario's [aero] quality (not with --quick, which selects 'tiny')")
+    p.add_argument("--aerodynamics", choices=AERODYNAMIC_CHOICES, default=None,
+                   help="the flutter stage's aerodynamics instead of the scenario's [flutter] aerodynamics: 'cfd' "
+                        "(the deck's own, from the aero stage), 'theodorsen' (thin plate, seconds) or "
+                        "'quasi_steady' (the scenario's [flutter.quasi_steady] static coefficients)")
     p.add_argument("--workers", type=int, default=None, metavar="N",
                    help="processes running the aero stage's CFD cases side by side (default: 2 on a machine "
                         "with 2 or more cores; 1: one after the other)")
@@ -154,7 +161,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         except BaseException:
             def kept() -> str:
                 folders = f"kept: {', '.join(map(str, written))}" if written else "no result folder written"
-                stored = not args.no_cache and any((args.out / ".cache").glob("*/*/output.pkl"))
+                stored = not args.no_cache and any((args.out / ".cache").glob("*/*/entry.h5"))
                 cached = f"; finished stages stay in {args.out / '.cache'}" if stored else ""
                 return f"interrupted; {folders}{cached}"
             return interrupts.reported(kept)
@@ -164,8 +171,12 @@ def _run(args: argparse.Namespace, say, written: list[Path]) -> int:
     stages = parse_stages(args.stages)
     if args.workers is not None and not 1 <= args.workers <= 64:
         raise InputError("--workers", args.workers, "allowed: 1 .. 64 processes")
+    if args.quick and args.quality not in (None, "tiny"):
+        raise InputError("--quality", args.quality, "not with --quick, which runs every stage coarse (the CFD on "
+                         "'tiny'): drop --quick to run this preset with the full FEM")
     # read and check everything before running anything, so bad input costs nothing
-    scenarios = [load_scenario(n, main_span_m=args.main_span) for n in args.scenarios]
+    scenarios = [with_aerodynamics(load_scenario(n, main_span_m=args.main_span), args.aerodynamics)
+                 for n in args.scenarios]
     seen: dict[str, str] = {}
     for arg, sc in zip(args.scenarios, scenarios, strict=True):
         if sc.name in seen:

@@ -40,7 +40,7 @@ from typing import Any
 
 import numpy as np
 
-from .config import check_name, load_scenario
+from .config import AERODYNAMIC_CHOICES, check_name, load_scenario, with_aerodynamics
 from .errors import ConvergenceError, InputError
 from .interrupts import Interrupts, exit_command
 from .workers import worker_pool
@@ -55,6 +55,12 @@ class Case:
     scenario: str
     main_span_m: float | None
     overrides: tuple[tuple[str, Any], ...]
+    aerodynamics: str | None = None   # --aerodynamics: the flutter stage's, for every case (not in the name)
+
+    def load(self):
+        """The case's validated scenario (:func:`bridge.config.load_scenario`)."""
+        sc = load_scenario(self.scenario, main_span_m=self.main_span_m, overrides=dict(self.overrides))
+        return with_aerodynamics(sc, self.aerodynamics)
 
     @property
     def name(self) -> str:
@@ -74,14 +80,15 @@ def _parse_value(text: str) -> Any:
     return text
 
 
-def plan_cases(scenario: str, spans: Sequence[float] | None, vary: dict[str, list[Any]]) -> list[Case]:
+def plan_cases(scenario: str, spans: Sequence[float] | None, vary: dict[str, list[Any]],
+               aerodynamics: str | None = None) -> list[Case]:
     """The cartesian product of spans and varied values, in a stable order."""
     span_list: list[float | None] = list(spans) if spans else [None]
     keys = list(vary)
     cases = []
     for span in span_list:
         for values in itertools.product(*(vary[k] for k in keys)) if keys else [()]:
-            cases.append(Case(scenario, span, tuple(zip(keys, values, strict=True))))
+            cases.append(Case(scenario, span, tuple(zip(keys, values, strict=True)), aerodynamics))
     return cases
 
 
@@ -94,7 +101,7 @@ def case_key(case: Case, stages: list[str] | None, quick: bool) -> str:
     from .pipeline import stage_keys
     from .stages import RunOptions
 
-    sc = load_scenario(case.scenario, main_span_m=case.main_span_m, overrides=dict(case.overrides))
+    sc = case.load()
     keys = stage_keys(sc, stages, RunOptions(quick=quick))
     blob = json.dumps({"stages": keys, "version": __version__}, sort_keys=True)
     return hashlib.sha256(blob.encode()).hexdigest()
@@ -140,7 +147,7 @@ def run_case(case: Case, out_dir: str, stages: list[str] | None, quick: bool,
         folder = Path(out_dir) / case.name
         if _finished_with(folder) == key:
             return case.name, "skipped"
-        sc = load_scenario(case.scenario, main_span_m=case.main_span_m, overrides=dict(case.overrides))
+        sc = case.load()
         sc = replace(sc, name=case.name)
         _, outputs = run_scenario(sc, Path(out_dir), stages,
                                   RunOptions(quick=quick, cache=Path(cache_dir) if cache_dir else None),
@@ -157,7 +164,17 @@ def run_case(case: Case, out_dir: str, stages: list[str] | None, quick: bool,
         if in_worker:
             signal.signal(signal.SIGINT, signal.SIG_IGN)
     reused = [name for name, out in outputs.items() if out.from_cache]
-    return case.name, "done" + (f" (from the cache: {', '.join(reused)})" if reused else "")
+    return case.name, "done" + _result_words(outputs) + (f" (from the cache: {', '.join(reused)})" if reused else "")
+
+
+def _result_words(outputs) -> str:
+    """What a finished case found, for its line on the terminal: the flutter speed and its modes (or that
+    none was found), else the first frequency or the cable force - the headline's first line."""
+    from .results import headline
+
+    summary = {k: v for out in outputs.values() for k, v in out.summary.items()}
+    first = headline(summary)[:1]
+    return f": {first[0]}" if first else ""
 
 
 def _as_float(value: Any) -> float:
@@ -326,6 +343,9 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--plot", default=None, help="summary key to plot against the main span")
     p.add_argument("--no-cache", action="store_true", help="compute every stage afresh (no OUT/.cache/)")
     p.add_argument("--quick", action="store_true", help="coarse meshes/grids")
+    p.add_argument("--aerodynamics", choices=AERODYNAMIC_CHOICES, default=None,
+                   help="the flutter stage's aerodynamics for every case instead of the scenario's (as for "
+                        "python -m bridge.scenario)")
     return p
 
 
@@ -359,7 +379,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                 if not vary[key.strip()]:
                     raise InputError("--vary", item, "needs at least one value after '='")
             stages = parse_stages(args.stages)
-            cases = plan_cases(args.scenario, spans, vary)
+            cases = plan_cases(args.scenario, spans, vary, args.aerodynamics)
             seen: dict[str, Case] = {}
             for c in cases:
                 if c.name in seen:
@@ -370,7 +390,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                 check_name(args.name, "--name")
             planned: set[str] = set()
             for c in cases:  # check every case's input and stages before running any
-                sc = load_scenario(c.scenario, main_span_m=c.main_span_m, overrides=dict(c.overrides))
+                sc = c.load()
                 planned |= set(plan_stages(sc, stages))
             if args.plot is not None and args.plot.split(".")[0] not in planned | {"scenario"}:
                 raise InputError("--plot", args.plot, f"names no result of the stages this sweep runs "

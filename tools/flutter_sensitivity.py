@@ -1,7 +1,7 @@
 """How much the flutter speed moves when one flutter derivative is off by a given factor.
 
     python tools/flutter_sensitivity.py great_belt [--derivatives H1 H2 H3 A1 A2 A3] [--factors 0.5 0.8 1.25 1.5]
-    python tools/flutter_sensitivity.py great_belt_sst --quality standard --cache /path/to/out/.cache
+    python tools/flutter_sensitivity.py great_belt --quality standard --cache /path/to/out/.cache
     python tools/flutter_sensitivity.py great_belt --together H3=1.1 A1=1.15 A2=1.5
 
 Why: the CFD's derivatives carry uncertainties that differ by derivative (docs/aero.md: with SST the thin

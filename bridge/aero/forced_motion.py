@@ -26,6 +26,7 @@ import hashlib
 import json
 import math
 import os
+import re
 import signal
 import tempfile
 import time
@@ -428,6 +429,47 @@ def _case_in_worker(shape, case, quality, checkpoint, checkpoint_every, label) -
         signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
+class RunProgress:
+    """The progress lines of several cases, each passed on with the whole run's time left appended.
+
+    Every case's lines start with its label and say how far its simulated time has come (``t = 12.3 of 48``,
+    ``resuming at t = 12.3``; :class:`bridge.cfd.ProgressNote`).  The run's time left is the simulated time
+    the cases still have to cover, at the rate the running cases show (simulated time per wall second,
+    each from its own lines, so a resumed case's head start does not count), times the cases that run at
+    once.  No estimate until a case has shown a rate."""
+
+    _T = re.compile(r"^(?P<label>.*?): (?:t = |resuming at t = )(?P<t>[-+0-9.eE]+)")
+
+    def __init__(self, jobs, quality: Quality, workers: int, sink: Callable[[str], None] | None):
+        self.t_end = {label: case.end_time(quality) for case, _, label in jobs}
+        self.workers, self.sink = max(1, min(workers, len(self.t_end))), sink
+        self.t = dict.fromkeys(self.t_end, 0.0)
+        self.first: dict[str, tuple[float, float]] = {}   # label -> (wall, t) of its first line here
+        self.rate: dict[str, float] = {}
+        self.done_rates: list[float] = []
+
+    def finished(self, label: str) -> None:
+        self.t[label] = self.t_end[label]
+        if label in self.rate:       # running cases set the pace; finished ones until one has shown its own
+            self.done_rates.append(self.rate.pop(label))
+
+    def __call__(self, line: str) -> None:
+        m = self._T.match(line)
+        if m and m["label"] in self.t:
+            label, t, now = m["label"], float(m["t"]), time.perf_counter()
+            self.t[label] = t
+            wall0, t0 = self.first.setdefault(label, (now, t))
+            if t > t0 and now > wall0:
+                self.rate[label] = (t - t0) / (now - wall0)
+            rates = list(self.rate.values()) or self.done_rates
+            if rates and len(self.t) > 1:
+                rate = sum(rates) / len(rates) * self.workers
+                left = sum(max(self.t_end[k] - self.t[k], 0.0) for k in self.t) / rate
+                line = f"{line} (all {len(self.t)} cases: about {left:.0f} s left)"
+        if self.sink is not None:
+            self.sink(line)
+
+
 def run_cases(shape, jobs, quality: Quality, checkpoint_every: int = 2000,
               progress: Callable[[str], None] | None = None, workers: int | None = None) -> list[ForceRecord]:
     """:func:`run_case` for every ``(case, checkpoint, label)`` of ``jobs``; the records in the jobs' order.
@@ -444,9 +486,14 @@ def run_cases(shape, jobs, quality: Quality, checkpoint_every: int = 2000,
     from bridge.workers import worker_pool
 
     workers = default_workers() if workers is None else workers
+    run = RunProgress(jobs, quality, workers, progress)
     if workers <= 1 or len(jobs) < 2:
-        return [run_case(shape, case, quality, ckpt, checkpoint_every, progress=progress, label=label)
-                for case, ckpt, label in jobs]
+        records = []
+        for case, ckpt, label in jobs:
+            records.append(run_case(shape, case, quality, ckpt, checkpoint_every,
+                                    progress=None if progress is None else run, label=label))
+            run.finished(label)
+        return records
 
     context = multiprocessing.get_context("spawn")   # fresh processes: no copy of this one's Warp threads
     lines, stopping = context.Queue(), context.Event()
@@ -457,19 +504,20 @@ def run_cases(shape, jobs, quality: Quality, checkpoint_every: int = 2000,
                 line = lines.get_nowait()
             except queues.Empty:
                 return
-            if progress is not None:
-                progress(line)
+            run(line)
 
     with worker_pool(min(workers, len(jobs)), context, _case_worker_start, (lines, stopping), stopping) as pool:
         try:
             futures = [pool.submit(_case_in_worker, shape, case, quality, ckpt, checkpoint_every, label)
                        for case, ckpt, label in jobs]
+            labels = {f: label for f, (_, _, label) in zip(futures, jobs, strict=True)}
             pending = set(futures)
             while pending:
                 done, pending = wait(pending, timeout=0.5, return_when=FIRST_EXCEPTION)
                 drain()
                 for f in done:
                     f.result()   # a failed case: raise its error now (worker_pool stops the others)
+                    run.finished(labels[f])
             drain()
         except BaseException:
             drain()
@@ -524,11 +572,16 @@ def _march(flow, polys, case, q, checkpoint, checkpoint_every, progress, label, 
     if checkpoint is not None:
         _save_checkpoint(checkpoint, key, flow, rec)
     arrays = {n: np.asarray(v, dtype=np.float64) for n, v in rec.items()}
-    from bridge.aero.snapshots import flow_snapshot
+    from bridge.aero.snapshots import body_grid_snapshot, flow_snapshot
 
     sim = flow.simulations[0]   # the fixed grid (overset: the background, which holds the body grid's flow
     grid = sim.grid             # at its own resolution in the hole)
-    snap = flow_snapshot(grid, sim.u.numpy(), sim.v.numpy(), sim.p.numpy(), polys, case.motion().pose(sim.t), sim.t)
+    pose = case.motion().pose(sim.t)
+    snap = flow_snapshot(grid, sim.u.numpy(), sim.v.numpy(), sim.p.numpy(), polys, pose, sim.t)
+    body = getattr(flow, "body", None)   # the overset pair's body grid: the section's own detail
+    if body is not None:
+        snap["body_grid"] = body_grid_snapshot(snap, body.grid, body.u.numpy(), body.v.numpy(), body.p.numpy(),
+                                               polys, pose)
     return ForceRecord(**arrays, steps=flow.n_steps, wall_s=time.perf_counter() - t0, resumed_from_step=resumed,
                        meta={"nx": grid.nx, "ny": grid.ny, "cells": flow.n_cells, "grids": flow.describe(),
                              "reynolds": q.reynolds, "quality": q.name, **asdict(case)}, snapshot=snap)

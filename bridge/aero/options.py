@@ -86,9 +86,12 @@ class AeroOptions:
         if self.quality not in QUALITY:
             raise InputError("aero.quality", self.quality, f"one of {', '.join(QUALITY)}")
         values = self.reduced_velocities
-        if isinstance(values, (str, bytes)) or not isinstance(values, (list, tuple)) or len(values) < 2:
+        if isinstance(values, (str, bytes)) or not isinstance(values, (list, tuple)):
             raise InputError("aero.reduced_velocities", values, "a list of at least 2 numbers U/(fB)")
+        # each value's range first: a list of one bad value is answered about the value, not the list's length
         rv = tuple(sorted(check_range(f"aero.reduced_velocities[{i}]", v, 0.5, 200.0) for i, v in enumerate(values)))
+        if len(rv) < 2:
+            raise InputError("aero.reduced_velocities", values, "a list of at least 2 numbers U/(fB)")
         if len(set(rv)) != len(rv):
             raise InputError("aero.reduced_velocities", values, "distinct values")
         object.__setattr__(self, "reduced_velocities", rv)
@@ -113,11 +116,13 @@ class AeroOptions:
                 or self.checkpoint_every < 10:
             raise InputError("aero.checkpoint_every", self.checkpoint_every, "an integer >= 10")
         angles = self.static_angles_deg
-        if isinstance(angles, (str, bytes)) or not isinstance(angles, (list, tuple)) or len(angles) == 1:
-            raise InputError("aero.static_angles_deg", angles, "a list of angles in degrees: none, or at least 2 "
-                             "(the slopes need two)")
+        need = "a list of angles in degrees: none, or at least 2 (the slopes need two)"
+        if isinstance(angles, (str, bytes)) or not isinstance(angles, (list, tuple)):
+            raise InputError("aero.static_angles_deg", angles, need)
         angles = tuple(sorted(check_range(f"aero.static_angles_deg[{i}]", a, -30.0, 30.0)
                               for i, a in enumerate(angles)))
+        if len(angles) == 1:
+            raise InputError("aero.static_angles_deg", self.static_angles_deg, need)
         if len(set(angles)) != len(angles):
             raise InputError("aero.static_angles_deg", self.static_angles_deg, "distinct values")
         object.__setattr__(self, "static_angles_deg", angles)

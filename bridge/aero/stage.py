@@ -24,6 +24,7 @@ from typing import Any
 
 import numpy as np
 
+from bridge.aero.accuracy import grid_accuracy
 from bridge.aero.forced_motion import (
     ForcedCase,
     StaticCase,
@@ -66,6 +67,8 @@ class AeroResult:
     grids: str = ""                    # the grids in words, e.g. "480 x 144 cells"
     turbulence: str = "laminar"        # [aero] turbulence: "laminar" or "sst"
     sst_walls: str = "equilibrium"     # [aero] sst_walls: "equilibrium", "function" or "blended" (with "sst")
+    grid_study: str = ""               # the preset's grid error as measured (bridge.aero.accuracy), or "none"
+    vc_grid_error_percent: tuple[float, float] | None = None   # V_c below the grid-converged one (low, high) %
 
     @property
     def reduced_velocity(self) -> np.ndarray:
@@ -159,8 +162,10 @@ def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
                             provides=measured)
     table.name = f"cfd ({section.name}, {quality}, Re {q.reynolds:.3g}{', SST' if q.turbulence == 'sst' else ''})"
     model = table if static is None else WithLateral(table, static.quasi_steady())
+    study, vc_error = grid_accuracy(section, aopts, quality, q.reynolds)
     data = AeroResult(section.describe(), quality, q.reynolds, cells, Ks, frf, stderr, model, tuple(records),
-                      warning, static, tuple(static_records), aopts.grid, grids, q.turbulence, q.sst_walls)
+                      warning, static, tuple(static_records), aopts.grid, grids, q.turbulence, q.sst_walls,
+                      study, vc_error)
     return StageOutput(summary=_summary(data), write_h5=lambda g: _write_h5(g, data), report=_report(data),
                        figures=_figures(data), data=data)
 
@@ -172,6 +177,15 @@ def preset_warnings(q, quality: str, section) -> str:
     notes = [] if cells_across >= 2.0 else [
         f"the section is {cells_across:.1f} cells thick on the {quality!r} grid (fewer than 2): the immersed "
         "boundary barely sees it and the forces are not to be trusted; use a finer preset"]
+    h = section.chord_m / q.cells_per_chord      # the body grid's cell along the chord (its larger side)
+    for i, part in enumerate(section.polygons()[1:], start=2):
+        x, y = part.vertices[:, 0], part.vertices[:, 1]
+        perimeter = float(np.hypot(np.diff(x, append=x[0]), np.diff(y, append=y[0])).sum())
+        thickness = 2 * part.area / perimeter    # a strip's thickness; a rectangle's harmonic mean of its sides
+        if thickness < 2 * h:
+            notes.append(f"part {i} of the section (about {thickness:.2g} m thick) spans {thickness / h:.1f} cells "
+                         f"of the {quality!r} grid (fewer than 2): the grid barely sees it and its share of the "
+                         "forces is not to be trusted; use a finer preset")
     if q.turbulence == "sst" and q.cells_per_chord > 80:
         notes.append(f"SST on the {quality!r} preset ({q.cells_per_chord} cells per chord) is untested: the finest SST "
                      "runs had 80 cells per chord (the Great Belt deck's grid study, docs/aero.md); a run that "
@@ -237,13 +251,17 @@ def _static_results(recs, section, aopts: AeroOptions, options: RunOptions):
 
 
 def _summary(d: AeroResult) -> dict[str, Any]:
+    err = d.vc_grid_error_percent
     s: dict[str, Any] = {"aero.section": d.section, "aero.quality": d.quality, "aero.reynolds": d.reynolds,
                          "aero.turbulence": d.turbulence,
                          **({"aero.sst_walls": d.sst_walls} if d.turbulence == "sst" else {}),
                          "aero.cases": len(d.records), "aero.grid_cells": d.cells, "aero.grid": d.grid,
                          "aero.reduced_velocity_min": float(d.reduced_velocity.min()),
                          "aero.reduced_velocity_max": float(d.reduced_velocity.max()),
-                         "aero.cfd_wall_s": float(sum(r["wall_s"] for r in d.records + d.static_records))}
+                         "aero.cfd_wall_s": float(sum(r["wall_s"] for r in d.records + d.static_records)),
+                         "aero.grid_study": d.grid_study,
+                         "aero.vc_grid_error_low_percent": None if err is None else err[0],
+                         "aero.vc_grid_error_high_percent": None if err is None else err[1]}
     if d.static is not None:
         (cd, dcd), (cl, dcl), (cm, dcm) = d.static.fits()
         i0 = int(np.argmin(np.abs(d.static.angles_deg)))
@@ -323,6 +341,8 @@ def _report(d: AeroResult) -> str:
                  f"URANS with the k-omega SST model (2003 variant) and {_WALLS[d.sst_walls]} at Re = "
                  f"{d.reynolds:.3g}") + ".  Heave and pitch with the thesis's velocity amplitudes, transient "
              "periods dropped, a least-squares harmonic fit over the whole periods left (docs/aero.md).", ""]
+    if d.grid_study:
+        lines += [f"Accuracy: {d.grid_study}.", ""]
     if d.warning:
         lines += [f"**Warning: {d.warning}.**", ""]
     lines += ["| U/(fB) | H1* | H1* Theodorsen | H3* | H3* Theodorsen | A1* | A1* Theodorsen | A2* "

@@ -17,7 +17,9 @@ Keys (all optional; defaults give a Theodorsen thin-plate analysis up to 150 m/s
                       moment_slope_per_rad (all required), drag_slope_per_rad (default 0): static
                       coefficients on the reference length B, slopes per radian.  With aerodynamics =
                       "quasi_steady" they are the whole model; with any other model they supply the
-                      lateral terms (drag, sway) that model lacks (bridge.flutter.aerodynamics.WithLateral)
+                      lateral terms (drag, sway) that model lacks (bridge.flutter.aerodynamics.WithLateral):
+                      with "cfd" only when the aero stage held the deck still at no angle (its own static
+                      coefficients are the deck's)
     air_density_kg_m3 overrides the scenario's [air] density (default: [air], else 1.225)
     max_speed_m_s     highest mean wind speed searched (default 150)
     min_speed_m_s     lowest speed searched (default 1 % of max_speed_m_s, or the table's lowest V)
@@ -168,9 +170,12 @@ class FlutterOptions:
             if cfd is None:
                 raise InputError("flutter.aerodynamics", "cfd", "needs the aero stage's result (run it: it is "
                                  "planned automatically with the flutter stage)")
-            # the aero stage completes its table with the lateral terms of its static runs; a scenario's own
-            # [flutter.quasi_steady] takes their place (below)
-            base = cfd.base if self.quasi_steady is not None and isinstance(cfd, WithLateral) else cfd
+            # the aero stage completes its table with the lateral terms of its static runs: the deck's own, which
+            # [flutter.quasi_steady] (static coefficients for models without them) does not replace; without
+            # static runs ([aero] static_angles_deg = []) the scenario's coefficients complete it (below)
+            if isinstance(cfd, WithLateral):
+                return cfd
+            base = cfd
         elif self.aerodynamics == "derivatives":
             base = DerivativeTable.from_csv(resolve(self.derivatives_path), convention=self.derivatives_convention,
                                             missing=self.missing_derivatives)

@@ -148,6 +148,7 @@ def _summary(d: FlutterStageResult, fopts: FlutterOptions) -> dict[str, float | 
     g = d.governing
     s: dict[str, float | int | bool | str | None] = {
         "flutter.flutter": g is not None, "flutter.aerodynamics": d.aerodynamics,
+        "flutter.aerodynamics_option": fopts.aerodynamics,
         "flutter.max_speed_searched_m_s": float(fopts.max_speed_m_s),
         "flutter.critical_speed_m_s": None if g is None else _number(g.critical_speed_m_s),
         "flutter.frequency_hz": None if g is None else _number(g.frequency_hz),
@@ -158,12 +159,53 @@ def _summary(d: FlutterStageResult, fopts: FlutterOptions) -> dict[str, float | 
         s[f"{key}.critical_speed_m_s"] = _number(r.critical_speed_m_s) if r.flutter else None
         s[f"{key}.frequency_hz"] = _number(r.frequency_hz) if r.flutter else None
         s[f"{key}.no_root_in_covered_range"] = r.no_root_in_covered_range   # a table's range, not "no flutter"
+    s.update(_coverage_summary(d, fopts))
     if d.multimode is not None:
         m = d.multimode
         s["flutter.multimode_critical_speed_m_s"] = _number(m.critical_speed_m_s) if m.flutter else None
         s["flutter.divergence_speed_m_s"] = _number(m.divergence_speed_m_s)
+        gaps = _pk_coverage(m)
+        s["flutter.multimode_uncovered"] = "; ".join(gaps) if gaps else None
     s.update(_lateral_summary(d))
     return s
+
+
+def _coverage_summary(d: FlutterStageResult, fopts: FlutterOptions) -> dict[str, float | bool | str | None]:
+    """Where the aerodynamic data leave the two-mode search blind, for the headline.
+
+    A pair's flutter frequency lies between its two natural frequencies, so at a speed V the search can find
+    it only where the data's reduced frequencies Omega = w B / V reach that band: from V = B w_min / Omega_max
+    up to B w_max / Omega_min.  ``flutter.blind_below_critical`` says, as text, below and above which speeds
+    each pair's band is out of the data's reach entirely, within the speeds that matter (up to the flutter
+    speed found, else the highest searched); ``flutter.data_span_every_pair`` is True when the data span every
+    pair's whole band at every speed searched (only then does "no flutter" mean none below the top speed)."""
+    m = d.modal_model
+    lows, highs = zip(*(r.covered_omega_range for r in d.pairs), strict=True) if d.pairs else ((0.0,), (np.inf,))
+    o_lo, o_hi = max(lows), min(highs)
+    if o_lo <= 0.0 and not math.isfinite(o_hi):   # a closed form: every frequency at every speed
+        return {"flutter.data_reduced_velocity_min": None, "flutter.data_reduced_velocity_max": None,
+                "flutter.data_span_every_pair": True, "flutter.blind_below_critical": None}
+    limit = d.governing.critical_speed_m_s if d.governing is not None else fopts.max_speed_m_s
+    below, above = [], []
+    for r in d.pairs:
+        w = [2 * math.pi * m.frequencies_hz[m.index(label)] for label in r.pair]
+        reach_from = m.deck_width_m * min(w) / o_hi
+        reach_to = m.deck_width_m * max(w) / o_lo if o_lo > 0 else math.inf
+        if reach_from > r.min_speed_searched_m_s:
+            below.append((min(reach_from, limit), _pair_name(r)))
+        if reach_to < limit:
+            above.append((reach_to, _pair_name(r)))
+    parts = []
+    if below:
+        lo, hi = min(v for v, _ in below), max(v for v, _ in below)
+        parts.append(f"below {lo:.0f} m/s" if len(below) == 1 or hi - lo < 0.5 else
+                     f"below {lo:.0f}-{hi:.0f} m/s (pair by pair: " + ", ".join(f"{p} {v:.0f}" for v, p in below) + ")")
+    if above:
+        parts.append("above " + ", ".join(f"{v:.0f} m/s for {p}" for v, p in above))
+    return {"flutter.data_reduced_velocity_min": _number(2 * math.pi / o_hi),
+            "flutter.data_reduced_velocity_max": _number(2 * math.pi / o_lo) if o_lo > 0 else None,
+            "flutter.data_span_every_pair": all(not r.uncovered_speeds_m_s for r in d.pairs),
+            "flutter.blind_below_critical": " and ".join(parts) if parts else None}
 
 
 def _lateral_report(d: FlutterStageResult) -> list[str]:

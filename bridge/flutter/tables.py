@@ -11,6 +11,7 @@ from __future__ import annotations
 import csv
 import warnings
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from scipy.interpolate import CubicSpline, RegularGridInterpolator
@@ -108,6 +109,17 @@ class FRFTable:
             values = FRF(**{k: np.asarray(g[k][()], dtype=np.complex128) for k in provides})
             return cls(g["reduced_frequency"][()], g["speed_m_s"][()], values, source=str(path), provides=provides)
 
+    def data_arguments(self) -> dict[str, Any]:
+        """The constructor's arguments (the tabulated values read back from the interpolators) and the
+        ``name`` when an instance has its own, for the stage cache (:mod:`bridge.datastore`)."""
+        values = FRF(**{n: re.values + 1j * im.values for n, (re, im) in self._interp.items()})
+        return {"omega": self.omega, "speed": self.speed, "values": values, "source": self.source,
+                "provides": self.provides, **_own_name(self)}
+
+    @classmethod
+    def from_data_arguments(cls, arguments: dict[str, Any]) -> FRFTable:
+        return _named(cls, arguments)
+
     @property
     def omega_range(self) -> tuple[float, float]:
         return (float(self.omega[0]), float(self.omega[-1]))
@@ -134,9 +146,24 @@ def _provides(provides, source: str) -> tuple[str, ...]:
     return tuple(n for n in FRF_NAMES if n in provides or n in VERTICAL_TORSIONAL)
 
 
+def _own_name(table) -> dict[str, str]:
+    """``{"name": ...}`` when the instance has a name of its own (not the class's), else nothing."""
+    return {"name": vars(table)["name"]} if "name" in vars(table) else {}
+
+
+def _named(cls, arguments: dict[str, Any]):
+    """A table built from its constructor's ``arguments``, given the name among them as its own."""
+    arguments = dict(arguments)
+    name = arguments.pop("name", None)
+    table = cls(**arguments)
+    if name is not None:
+        table.name = name
+    return table
+
+
 class _Linear:
     """Linear interpolation of complex values (used when a table has fewer than 4 rows); a class, not a
-    closure, so that a table can be pickled (the stage cache stores it)."""
+    closure, so that a table can be pickled (e.g. sent to a worker process)."""
 
     def __init__(self, x_table: np.ndarray, y_table: np.ndarray):
         self.x, self.y = np.asarray(x_table), np.asarray(y_table)
@@ -205,8 +232,8 @@ class DerivativeTable:
             raise InputError("flutter.derivatives_path", str(path), "an existing CSV file")
         source = str(path)
         stated = Convention()
-        data_lines = []
-        for line in path.read_text().splitlines():
+        numbered = []   # (line number in the file, cells) of the header and data rows
+        for n, line in enumerate(path.read_text().splitlines(), start=1):
             text = line.strip()
             if text.startswith("#"):
                 body = text.lstrip("#").strip()
@@ -214,8 +241,10 @@ class DerivativeTable:
                     stated = stated.merged(Convention.parse(body.split(":", 1)[1], f"{source}: convention"),
                                            "an earlier convention line", "a later one")
             elif text:
-                data_lines.append(line)
-        rows = [r for r in csv.reader(data_lines) if any(c.strip() for c in r)]
+                cells = next(csv.reader([line]))
+                if any(c.strip() for c in cells):
+                    numbered.append((n, cells))
+        rows = [cells for _, cells in numbered]
         if len(rows) < 3:
             raise InputError(source, len(rows), "a header row and at least 2 data rows")
         header = [c.strip().rstrip("*").strip() for c in rows[0]]
@@ -247,15 +276,20 @@ class DerivativeTable:
                              "a derivative table must state its convention; " + _HOW_TO)
         stated.require(given, source)
         width = len(header)
-        uneven = [i + 2 for i, r in enumerate(rows[1:]) if len(r) != width]
+        uneven = [n for n, r in numbered[1:] if len(r) != width]
         if uneven:
-            raise InputError(source, f"data rows {uneven[:5]}", f"{width} cells in every row, as in the header")
-        try:
-            data = np.array([[float(c) for c in r] for r in rows[1:]], dtype=np.float64)
-        except ValueError as exc:
-            raise InputError(source, str(exc), "numbers in every data cell") from None
-        if not np.all(np.isfinite(data)):
-            raise InputError(source, "nan or inf", "finite numbers in every data cell")
+            raise InputError(source, f"lines {uneven[:5]}", f"{width} cells in every row, as in the header")
+        data = np.empty((len(rows) - 1, width), dtype=np.float64)
+        for i, (n, r) in enumerate(numbered[1:]):
+            for j, cell in enumerate(r):
+                try:
+                    data[i, j] = float(cell)
+                except ValueError:
+                    raise InputError(f"{source}: line {n}, column {header[j] or j + 1}", cell.strip(),
+                                     "must be a number") from None
+                if not np.isfinite(data[i, j]):
+                    raise InputError(f"{source}: line {n}, column {header[j] or j + 1}", cell.strip(),
+                                     "must be a finite number")
         col = {h: data[:, i] for i, h in enumerate(header)}
         x = col[arguments[0]]
         if np.any(x <= 0.0):
@@ -265,6 +299,16 @@ class DerivativeTable:
         provides = VERTICAL_TORSIONAL + tuple(f for f in LATERAL if any(n in given for n in DERIVATIVE_PAIRS[f]))
         d = FlutterDerivatives(**{n: scanlan.get(n, np.zeros_like(K)) for n in DERIVATIVE_NAMES})
         return cls(K, d, source=source, provides=provides, convention=stated)
+
+    def data_arguments(self) -> dict[str, Any]:
+        """The constructor's arguments and the ``name`` when an instance has its own (the aero stage names
+        its table), for the stage cache (:mod:`bridge.datastore`)."""
+        return {"K": self.K, "derivatives": self.derivatives, "source": self.source, "provides": self.provides,
+                "convention": self.convention, **_own_name(self)}
+
+    @classmethod
+    def from_data_arguments(cls, arguments: dict[str, Any]) -> DerivativeTable:
+        return _named(cls, arguments)
 
     @property
     def omega_range(self) -> tuple[float, float]:

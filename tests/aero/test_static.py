@@ -104,7 +104,8 @@ def test_a_thin_plate_held_still_has_thin_aerofoil_slopes_and_symmetry():
 def test_the_static_group_report_and_lateral_model(tmp_path):
     """results.h5 /aero/static as docs/results.md lists it (every dataset with unit and description), the
     report's wording for a steady and an unresolved wake, and the flutter model: the CFD table completed by
-    the static runs' lateral terms, unless the scenario gives its own [flutter.quasi_steady]."""
+    the static runs' lateral terms, which a scenario's [flutter.quasi_steady] does not replace (it completes a
+    CFD table without static runs)."""
     import h5py
 
     from bridge.aero.stage import _static_report, _write_static_h5
@@ -137,7 +138,8 @@ def test_the_static_group_report_and_lateral_model(tmp_path):
     own = FlutterOptions.from_mapping({"aerodynamics": "cfd", "quasi_steady": {
         "lift_coefficient": 0.0, "lift_slope_per_rad": 5.0, "drag_coefficient": 0.3, "moment_coefficient": 0.0,
         "moment_slope_per_rad": 1.0}})
-    model = own.aerodynamic_model(cfd=cfd)
+    assert own.aerodynamic_model(cfd=cfd) is cfd   # the deck's own static coefficients stay
+    model = own.aerodynamic_model(cfd=cfd.base)     # a CFD table without static runs: completed by the scenario's
     assert model.base is cfd.base and model.lateral.drag_coefficient == 0.3
 
 

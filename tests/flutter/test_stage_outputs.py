@@ -13,18 +13,23 @@ import h5py
 import numpy as np
 import pytest
 
-from bridge.config import load_scenario
+from bridge.config import load_scenario, with_aerodynamics
 from bridge.pipeline import run_stages
 from bridge.stages import RunOptions
 
-# great_belt: cable -> fem -> flutter; great_belt_thesis_modes: kind "modal", the flutter stage alone
-# (no flutter below 150 m/s: the no-solution paths).
+# great_belt: cable -> fem -> flutter (Theodorsen's aerodynamics: the stages' outputs, not the CFD's, are
+# checked here; tests/aero checks the aero stage's); great_belt_thesis_modes: kind "modal", the flutter stage
+# alone (no flutter below 150 m/s: the no-solution paths).
 SCENARIOS = ("great_belt", "great_belt_thesis_modes")
+
+
+def theodorsen(name: str):
+    return with_aerodynamics(load_scenario(name), "theodorsen")
 
 
 @pytest.fixture(scope="module")
 def outputs():
-    return {name: run_stages(load_scenario(name), None, RunOptions(quick=True)) for name in SCENARIOS}
+    return {name: run_stages(theodorsen(name), None, RunOptions(quick=True)) for name in SCENARIOS}
 
 
 @pytest.mark.parametrize("name", SCENARIOS)
@@ -119,7 +124,7 @@ def test_damping_plot_highlights_the_unstable_branch_and_leaves_out_non_oscillat
 
 
 def test_flutter_stage_plots_the_governing_pair_when_the_fem_ran():
-    out = run_stages(load_scenario("model_c"), None, RunOptions(quick=True))
+    out = run_stages(theodorsen("model_c"), None, RunOptions(quick=True))
     fem, flutter = out["fem"].figures, out["flutter"].figures
     pair = out["flutter"].data.governing.pair
     assert pair == ("SS-V1", "SS-T1")                  # skew-symmetric: the fem stage plots S modes only

@@ -256,7 +256,8 @@ def test_summary_json_is_strict_json(tmp_path):
 # ------------------------------------------------------------------------------ sweeps
 @pytest.mark.slow  # ~11 s of full pipeline runs: runs in CI with -m slow (default run under 2 min)
 def test_sweep_resumes_only_cases_run_with_the_same_stages(tmp_path):
-    base = ["great_belt", "--main-span", "1624", "--quick", "--workers", "1", "--out", str(tmp_path)]
+    base = ["great_belt", "--main-span", "1624", "--quick", "--aerodynamics", "theodorsen", "--workers", "1",
+            "--out", str(tmp_path)]
     assert cli(*base, "--stages", "cable", module="bridge.sweep").returncode == 0
     proc = cli(*base, "--stages", "fem", module="bridge.sweep")   # more stages than the finished case
     assert proc.returncode == 0, proc.stderr
@@ -309,7 +310,8 @@ def test_sweep_checks_stages_and_plot_key_before_running(tmp_path):
 # ------------------------------------------------------------------------------ Ctrl-C
 @pytest.mark.parametrize("module, args", [
     ("bridge.scenario", ["great_belt", "model_a", "model_b"]),
-    pytest.param("bridge.sweep", ["great_belt", "--main-span", "1624,2000,3000", "--workers", "2"],
+    pytest.param("bridge.sweep", ["great_belt", "--main-span", "1624,2000,3000", "--workers", "2",
+                                  "--aerodynamics", "theodorsen"],
                  marks=pytest.mark.slow),   # ~18 s: runs in CI with -m slow
 ])
 def test_ctrl_c_is_one_line_and_exit_130(tmp_path, module, args):
@@ -356,10 +358,11 @@ def test_ctrl_c_is_one_line_and_exit_130(tmp_path, module, args):
 @pytest.mark.slow  # ~17 s (five runs of the pipeline): runs in CI with -m slow; the keys are checked below
 def test_stage_cache_reuses_unchanged_stages_only(tmp_path):
     out = str(tmp_path / "out")
-    first = cli("great_belt", "--quick", "--out", out)
+    theodorsen = ("--aerodynamics", "theodorsen")   # the cache of the stages, not the CFD's, is checked here
+    first = cli("great_belt", "--quick", *theodorsen, "--out", out)
     assert first.returncode == 0 and "reusing" not in first.stderr
     vc = strict_json(tmp_path / "out" / "great_belt" / "summary.json")["flutter.critical_speed_m_s"]
-    proc = cli("great_belt", "--stages", "flutter", "--quick", "--overwrite", "--out", out)
+    proc = cli("great_belt", "--stages", "flutter", "--quick", *theodorsen, "--overwrite", "--out", out)
     assert proc.returncode == 0, proc.stderr
     for stage in ("cable", "fem", "flutter"):
         assert re.search(rf"{stage}: inputs unchanged, reusing", proc.stderr), proc.stderr
@@ -368,8 +371,9 @@ def test_stage_cache_reuses_unchanged_stages_only(tmp_path):
 
     # a flutter option changed: cable and fem reused, flutter recomputed
     f = copy_scenario("great_belt", tmp_path / "great_belt.toml",
-                      lambda t: t + '\n[flutter]\nmax_speed_m_s = 140.0\nmultimode = false\n')
-    proc = cli(str(f), "--quick", "--overwrite", "--out", out)
+                      lambda t: t.replace('aerodynamics = "cfd"\n',
+                                          'aerodynamics = "cfd"\nmax_speed_m_s = 140.0\nmultimode = false\n', 1))
+    proc = cli(str(f), "--quick", *theodorsen, "--overwrite", "--out", out)
     assert proc.returncode == 0, proc.stderr
     assert "cable: inputs unchanged" in proc.stderr and "fem: inputs unchanged" in proc.stderr
     assert "flutter: inputs unchanged" not in proc.stderr
@@ -440,7 +444,7 @@ def test_a_shared_stage_is_one_result_for_scenarios_of_other_names(monkeypatch):
 # ------------------------------------------------------------------------------ what a user reads
 @pytest.mark.slow  # ~15 s of full pipeline runs: runs in CI with -m slow (default run under 2 min)
 def test_headline_on_the_terminal_and_atop_the_report(tmp_path):
-    proc = cli("great_belt", "thin_plate_section", "--quick", "--out", str(tmp_path))
+    proc = cli("great_belt", "thin_plate_section", "--quick", "--aerodynamics", "theodorsen", "--out", str(tmp_path))
     assert proc.returncode == 0, proc.stderr
     for name, pair in (("great_belt", "S-V1+S-T1"), ("thin_plate_section", "heave+pitch")):
         block = proc.stdout.split(f"{name}: results in")[1]
