@@ -8,6 +8,9 @@ worker left behind computes at full CPU for nobody, so two guards hold:
   the parent's sentinel (a pipe the parent alone holds open) and ends the worker at once when the parent
   is gone - killed outright (SIGKILL, an out-of-memory kill), or exited without stopping it.  This is the
   guarantee; it needs nothing from the parent.
+* **a worker ignores Ctrl-C** (the terminal sends it to the whole process group) from its first instruction
+  to the end of its start-up, and then while no task asks for it; the parent forwards it to the running
+  tasks (:class:`_Pool`, :func:`_start_worker`);
 * **the parent stops its workers** when the run is interrupted (Ctrl-C, SIGTERM through
   :class:`bridge.interrupts.Interrupts`) or a case fails (:func:`worker_pool`): the cases not started are
   cancelled, the running ones receive SIGINT (so that they stop between two steps), and whatever is still
@@ -52,9 +55,42 @@ def watch_parent() -> None:
 
 
 def _start_worker(initializer: Callable | None, initargs: tuple) -> None:
+    """First thing in every worker: watch the parent, leave Ctrl-C to the parent (SIGINT ignored until a task
+    of the caller's asks for it), run the caller's initializer, then let SIGINT in (it arrives blocked:
+    :class:`_Pool`), so that one sent while the worker was still importing is dropped."""
     watch_parent()
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     if initializer is not None:
         initializer(*initargs)
+    if hasattr(signal, "pthread_sigmask"):
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+
+
+@contextlib.contextmanager
+def _sigint_held() -> Iterator[None]:
+    """SIGINT blocked in this thread for the block: a Ctrl-C that lands meanwhile waits, and is delivered
+    (to the usual handler) when the block ends."""
+    if not hasattr(signal, "pthread_sigmask"):
+        yield
+        return
+    before = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, before)
+
+
+class _Pool(ProcessPoolExecutor):
+    """A ProcessPoolExecutor that starts its workers with SIGINT blocked.
+
+    Workers start inside ``submit``.  A worker inherits the blocked signal (across fork and exec), so a
+    Ctrl-C that reaches the whole process group while a new worker still imports the program - before its
+    initializer ignores SIGINT - does not print that import's traceback; the parent's own Ctrl-C waits the
+    few milliseconds ``submit`` takes."""
+
+    def submit(self, fn, /, *args, **kwargs):
+        with _sigint_held():
+            return super().submit(fn, *args, **kwargs)
 
 
 def stop_processes(processes, grace_s: float = 10.0, interrupt: bool = True) -> None:
@@ -93,8 +129,8 @@ def worker_pool(workers: int, context=None, initializer: Callable | None = None,
     ``stopping``: an Event handed to the workers (through ``initargs``) that is set before they are stopped,
     so that a task a worker takes from the queue after the interrupt does not start.  On a normal exit the
     pool is shut down and waited for, as ``with ProcessPoolExecutor(...)`` does."""
-    pool = ProcessPoolExecutor(max_workers=workers, mp_context=context or multiprocessing.get_context(),
-                               initializer=_start_worker, initargs=(initializer, initargs))
+    pool = _Pool(max_workers=workers, mp_context=context or multiprocessing.get_context(),
+                 initializer=_start_worker, initargs=(initializer, initargs))
     try:
         yield pool
     except BaseException:

@@ -436,7 +436,8 @@ class RunProgress:
     ``resuming at t = 12.3``; :class:`bridge.cfd.ProgressNote`).  The run's time left is the simulated time
     the cases still have to cover, at the rate the running cases show (simulated time per wall second,
     each from its own lines, so a resumed case's head start does not count), times the cases that run at
-    once.  No estimate until a case has shown a rate."""
+    once (the workers, or the unfinished cases when fewer are left).  No estimate until a case has shown a
+    rate."""
 
     _T = re.compile(r"^(?P<label>.*?): (?:t = |resuming at t = )(?P<t>[-+0-9.eE]+)")
 
@@ -462,8 +463,9 @@ class RunProgress:
             if t > t0 and now > wall0:
                 self.rate[label] = (t - t0) / (now - wall0)
             rates = list(self.rate.values()) or self.done_rates
-            if rates and len(self.t) > 1:
-                rate = sum(rates) / len(rates) * self.workers
+            unfinished = sum(self.t[k] < self.t_end[k] for k in self.t)
+            if rates and len(self.t) > 1 and unfinished:
+                rate = sum(rates) / len(rates) * min(self.workers, unfinished)   # the cases that can still run at once
                 left = sum(max(self.t_end[k] - self.t[k], 0.0) for k in self.t) / rate
                 line = f"{line} (all {len(self.t)} cases: about {left:.0f} s left)"
         if self.sink is not None:

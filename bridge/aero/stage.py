@@ -183,9 +183,11 @@ def preset_warnings(q, quality: str, section) -> str:
         perimeter = float(np.hypot(np.diff(x, append=x[0]), np.diff(y, append=y[0])).sum())
         thickness = 2 * part.area / perimeter    # a strip's thickness; a rectangle's harmonic mean of its sides
         if thickness < 2 * h:
+            need = math.ceil(2 * section.chord_m / thickness)
             notes.append(f"part {i} of the section (about {thickness:.2g} m thick) spans {thickness / h:.1f} cells "
                          f"of the {quality!r} grid (fewer than 2): the grid barely sees it and its share of the "
-                         "forces is not to be trusted; use a finer preset")
+                         f"forces is not to be trusted; two cells across it take {need} cells per chord "
+                         "('fine' has 80)")
     if q.turbulence == "sst" and q.cells_per_chord > 80:
         notes.append(f"SST on the {quality!r} preset ({q.cells_per_chord} cells per chord) is untested: the finest SST "
                      "runs had 80 cells per chord (the Great Belt deck's grid study, docs/aero.md); a run that "

@@ -340,3 +340,25 @@ def test_an_asymmetric_deck_with_a_wind_screen_runs_through_the_cfd():
     for name in ("lift", "drag", "moment"):
         assert np.all(np.isfinite(getattr(rec, name))), name
     assert np.abs(rec.lift).max() > 0
+
+
+@pytest.mark.slow   # ~2.5 min: three runs of the whole chain (coarse FEM, 'tiny' CFD); runs in CI with -m slow
+def test_a_polygon_deck_inline_from_csv_and_from_dxf_runs_through_the_chain(tmp_path):
+    """The same asymmetric deck given three ways runs cable, fem, aero and flutter, gives one answer, and the
+    headline says that no grid study covers this deck (and that the screen is too thin for the grid)."""
+    write_csv(tmp_path / "deck.csv", {"box": BOX, "screen": SCREEN})
+    write_dxf(tmp_path / "deck.dxf", [BOX, SCREEN])
+    ways = {"inline": f"parts = {[closed(BOX), closed(SCREEN)]}", "csv": 'outline_path = "deck.csv"',
+            "dxf": 'outline_path = "deck.dxf"'}
+    found = {}
+    for way, table in ways.items():
+        path = scenario_file(tmp_path, table)
+        out = tmp_path / f"out_{way}"
+        proc = subprocess.run([sys.executable, "-m", "bridge.scenario", str(path), "--quick", "--out", str(out)],
+                              capture_output=True, text=True, cwd=REPO, timeout=900)
+        assert proc.returncode == 0, proc.stderr[-3000:]
+        head = proc.stdout
+        assert "the deck's own, from forced-motion CFD" in head and "no grid study covers" in head, head
+        assert "part 2 of the section" in proc.stderr                       # the 0.25 m screen on 'tiny'
+        found[way] = [line for line in head.splitlines() if "V_c" in line or "no flutter" in line.lower()][0]
+    assert found["inline"] == found["csv"] == found["dxf"], found

@@ -58,7 +58,7 @@ def start(args: list[str], token: str, cwd: Path = REPO) -> tuple[subprocess.Pop
     """Start ``python args`` with the token in its environment; its stderr lines collect in the list."""
     env = {**os.environ, "BRIDGE_TEST_TOKEN": token}
     proc = subprocess.Popen([sys.executable, *args], cwd=cwd, env=env, stdout=subprocess.PIPE,
-                            stderr=subprocess.STDOUT, text=True)
+                            stderr=subprocess.STDOUT, text=True, start_new_session=True)   # its own process group
     lines: list[str] = []
     threading.Thread(target=lambda: lines.extend(proc.stdout), daemon=True).start()
     return proc, lines
@@ -112,20 +112,25 @@ def test_workers_end_by_themselves_when_their_parent_is_killed(tmp_path):
             os.kill(pid, signal.SIGKILL)
 
 
-@pytest.mark.slow   # ~40 s: four runs of the CFD chain, interrupted; runs in CI with -m slow
-@pytest.mark.parametrize("signum, after, status", [
-    (signal.SIGINT, "aero: ", 130),                 # while the workers are being started
-    (signal.SIGINT, "aero case", 130),              # while both compute
-    (signal.SIGINT, "aero static", 130),            # later cases queued behind running ones
-    (signal.SIGTERM, "aero case", 143),             # a batch system's or a CI time-out's stop
+@pytest.mark.slow   # ~70 s: six runs of the CFD chain, interrupted; runs in CI with -m slow
+@pytest.mark.parametrize("signum, after, group, status", [
+    (signal.SIGINT, "aero: ", False, 130),          # while the workers are being started
+    (signal.SIGINT, "aero: ", True, 130),           # ... by a terminal's Ctrl-C, which every process gets
+    (signal.SIGINT, "aero case", False, 130),       # while both compute
+    (signal.SIGINT, "aero case", True, 130),
+    (signal.SIGINT, "aero static", False, 130),     # later cases queued behind running ones
+    (signal.SIGTERM, "aero case", False, 143),      # a batch system's or a CI time-out's stop
 ])
-def test_an_interrupted_cfd_chain_leaves_no_worker(tmp_path, signum, after, status):
+def test_an_interrupted_cfd_chain_leaves_no_worker(tmp_path, signum, after, group, status):
     token = uuid.uuid4().hex
     proc, lines = start(["-m", "bridge.scenario", "great_belt", "--stages", "aero", "--quality", "tiny",
                          "--out", str(tmp_path / "out")], token)
     try:
         wait_for(lines, after, proc)
-        proc.send_signal(signum)
+        if group:
+            os.killpg(proc.pid, signum)
+        else:
+            proc.send_signal(signum)
         assert proc.wait(timeout=60) == status, "".join(lines)[-2000:]
         assert left_behind(token) == []
         last = "".join(lines).strip().splitlines()[-1]
