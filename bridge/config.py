@@ -630,9 +630,10 @@ def load_scenario(name_or_path: str | Path, main_span_m: float | None = None,
     reference's, key by key (``[girder] width_m = 40.0`` changes the girder's width and nothing else;
     ``[aero]`` and ``[flutter]`` likewise; a ``[deck_section]`` with a ``shape`` is a section of its own), then
     up-scaled to the file's ``main_span_m`` by the rules of thesis 1.5 (:mod:`bridge.upscaling`), applied
-    once, from the full bridge at the end of a chain of references.  ``main_span_m`` overrides the file's main span (command line ``--main-span``).
-    ``overrides`` sets dotted input keys before validation (for sweeps); the key must exist in the file or,
-    for an up-scaled bridge, in the tables it has with its reference.
+    once, from the full bridge at the end of a chain of references.  ``main_span_m`` overrides the file's
+    main span (command line ``--main-span``).  ``overrides`` sets dotted input keys before validation (for
+    sweeps); the key must exist in the file or, for an up-scaled bridge, in the tables it has with its
+    reference.
     """
     path = scenario_path(name_or_path)
     data = _read_toml(path)

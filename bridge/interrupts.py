@@ -26,7 +26,7 @@ import sys
 import threading
 import time
 
-__all__ = ["Interrupts", "stop_quietly_while_loading", "exit_command", "INTERRUPTED", "TERMINATED"]
+__all__ = ["Interrupts", "stop_quietly_while_loading", "exit_command", "sigint_held", "INTERRUPTED", "TERMINATED"]
 
 INTERRUPTED = 128 + signal.SIGINT    # 130, the shell's convention
 TERMINATED = 128 + signal.SIGTERM    # 143
@@ -55,6 +55,22 @@ def exit_command(status: int) -> None:
         sys.stderr.flush()
         os._exit(status)
     sys.exit(status)
+
+
+@contextlib.contextmanager
+def sigint_held():
+    """SIGINT blocked in the calling thread for the block: a Ctrl-C that lands meanwhile waits and is
+    delivered (to the usual handler) when the block ends.  For the steps that must not be cut in half (a
+    result folder renamed into place) and for starting worker processes, which inherit the blocked signal
+    (:mod:`bridge.workers`).  A no-op where the platform cannot block signals."""
+    if not hasattr(signal, "pthread_sigmask"):
+        yield
+        return
+    before = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, before)
 
 
 class Interrupts:

@@ -15,7 +15,6 @@ The HDF5 schema is documented in ``docs/results.md``.
 
 from __future__ import annotations
 
-import contextlib
 import json
 import math
 import os
@@ -34,6 +33,7 @@ from . import __version__
 from .config import Scenario, scenario_fields
 from .errors import InputError
 from .files import file_mode, folder_mode
+from .interrupts import sigint_held
 from .stages import StageOutput
 
 __all__ = ["write_results", "write_dataset", "check_target", "summary_json", "headline", "SCHEMA_VERSION"]
@@ -224,7 +224,7 @@ def _swap_into_place(tmp: Path, final: Path, new_files: set[str]) -> None:
                          "move it away first (it would be replaced)")
     moved: list[str] = []
     old: Path | None = None
-    with _no_interrupts():   # a few renames: Ctrl-C waits for them, so no entry is left half-moved
+    with sigint_held():   # a few renames: Ctrl-C waits for them, so no entry is left half-moved
         try:
             for p in keep:
                 moved.append(p.name)   # before the move: an entry is never out of its folder unrecorded
@@ -242,22 +242,6 @@ def _swap_into_place(tmp: Path, final: Path, new_files: set[str]) -> None:
                 shutil.rmtree(old, ignore_errors=True)
             raise
         shutil.rmtree(old, ignore_errors=True)
-
-
-@contextlib.contextmanager
-def _no_interrupts():
-    """Hold SIGINT back (delivered on leaving) in the main thread; elsewhere a no-op."""
-    import signal
-    import threading
-
-    if threading.current_thread() is not threading.main_thread() or not hasattr(signal, "pthread_sigmask"):
-        yield
-        return
-    previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
-    try:
-        yield
-    finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
 
 
 def write_results(out_root: Path, scenario: Scenario, outputs: Mapping[str, StageOutput],

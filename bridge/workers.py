@@ -32,6 +32,8 @@ import time
 from collections.abc import Callable, Iterator
 from concurrent.futures import ProcessPoolExecutor
 
+from .interrupts import sigint_held
+
 __all__ = ["watch_parent", "worker_pool", "stop_processes", "ORPHANED"]
 
 ORPHANED = 70   # a worker's exit status when it ends because its parent is gone (EX_SOFTWARE)
@@ -66,20 +68,6 @@ def _start_worker(initializer: Callable | None, initargs: tuple) -> None:
         signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
 
 
-@contextlib.contextmanager
-def _sigint_held() -> Iterator[None]:
-    """SIGINT blocked in this thread for the block: a Ctrl-C that lands meanwhile waits, and is delivered
-    (to the usual handler) when the block ends."""
-    if not hasattr(signal, "pthread_sigmask"):
-        yield
-        return
-    before = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
-    try:
-        yield
-    finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, before)
-
-
 class _Pool(ProcessPoolExecutor):
     """A ProcessPoolExecutor that starts its workers with SIGINT blocked.
 
@@ -89,7 +77,7 @@ class _Pool(ProcessPoolExecutor):
     few milliseconds ``submit`` takes."""
 
     def submit(self, fn, /, *args, **kwargs):
-        with _sigint_held():
+        with sigint_held():
             return super().submit(fn, *args, **kwargs)
 
 
