@@ -34,13 +34,11 @@ import shutil
 import tempfile
 from collections.abc import Mapping
 from dataclasses import replace
-from functools import cache
-from importlib.util import find_spec
 from pathlib import Path
 from typing import Any
 
 from . import __version__, datastore
-from .stages import IDENTITY_FIELDS, STAGES, StageOutput
+from .stages import IDENTITY_FIELDS, STAGES, StageOutput, code_digest
 
 __all__ = ["stage_key", "store", "load", "save", "StoredGroup", "UnreadableEntry", "CACHE_FORMAT", "ENTRY"]
 
@@ -56,24 +54,6 @@ class UnreadableEntry(Exception):
     def __init__(self, path: Path, reason: str):
         super().__init__(f"{path}: {reason}")
         self.path, self.reason = path, reason
-
-
-@cache
-def _code_digest(modules: tuple[str, ...]) -> str:
-    """SHA-256 over the source files of the given modules and packages (packages: every .py inside)."""
-    h = hashlib.sha256()
-    for name in modules:
-        spec = find_spec(name)
-        if spec is None:
-            raise KeyError(f"stage code {name!r} is not an importable module")
-        if spec.submodule_search_locations:
-            files = sorted(p for loc in spec.submodule_search_locations for p in Path(loc).rglob("*.py"))
-        else:
-            files = [Path(spec.origin)]
-        for f in files:
-            h.update(f.name.encode())
-            h.update(f.read_bytes())
-    return h.hexdigest()
 
 
 def _file_digest(path: Path) -> str:
@@ -101,7 +81,7 @@ def stage_key(name: str, scenario: Any, upstream_keys: Mapping[str, str], quick:
             p = Path(v) if Path(v).is_absolute() else base / v
             files[k] = _file_digest(p) if p.is_file() else "missing"
     blob = json.dumps({"format": CACHE_FORMAT, "stage": name, "version": __version__,
-                       "code": _code_digest(COMMON_CODE + stage.code), "inputs": inputs, "files": files,
+                       "code": code_digest(COMMON_CODE + stage.code), "inputs": inputs, "files": files,
                        "upstream": {k: upstream_keys[k] for k in sorted(upstream_keys)}, "quick": bool(quick),
                        **({"quality": quality} if quality is not None else {})},
                       sort_keys=True, default=repr)

@@ -26,11 +26,26 @@ import os
 import re
 import tomllib
 from collections.abc import Mapping
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import fields, replace
 from pathlib import Path
 from typing import Any
 
-from .errors import InputError, check_range
+from .errors import InputError
+from .inputs import (
+    GRAVITY_M_S2,
+    Air,
+    BoxSection,
+    Cable,
+    DampingEntry,
+    Geometry,
+    Girder,
+    Hanger,
+    Material,
+    Pylon,
+    Scenario,
+)
+from .toml_table import Table
+from .upscaling import upscale
 
 __all__ = [
     "Material", "BoxSection", "Geometry", "Girder", "Cable", "Hanger", "Pylon", "DampingEntry", "Air",
@@ -39,301 +54,14 @@ __all__ = [
     "check_deck_chord", "flutter_deck_width", "CHORD_TOLERANCE",
 ]
 
-GRAVITY_M_S2 = 9.81  # the thesis's value (Eq 1.2, 2.3)
 SCENARIO_DIR = Path(__file__).resolve().parent.parent / "scenarios"
-
-
-# ----------------------------------------------------------------------------------------- reading helpers
-class _Table:
-    """A TOML table being read: tracks which keys were used so unknown keys can be rejected."""
-
-    def __init__(self, data: Mapping[str, Any], where: str):
-        if not isinstance(data, Mapping):
-            raise InputError(where, data, "must be a table")
-        self.data, self.where, self.used = data, where, set()
-
-    def key(self, name: str) -> str:
-        return f"{self.where}.{name}" if self.where else name
-
-    def raw(self, name: str, default: Any = ...) -> Any:
-        self.used.add(name)
-        if name not in self.data:
-            if default is ...:
-                raise InputError(self.key(name), None, "missing (required key)")
-            return default
-        return self.data[name]
-
-    def number(self, name: str, low: float | None = 0.0, high: float | None = None, low_open: bool = True,
-               high_open: bool = False, default: Any = ...) -> float:
-        value = self.raw(name, default)
-        return check_range(self.key(name), value, low, high, low_open, high_open)
-
-    def integer(self, name: str, low: int = 0, high: int | None = None, default: Any = ...) -> int:
-        value = self.raw(name, default)
-        if isinstance(value, bool) or not isinstance(value, int):
-            raise InputError(self.key(name), value, "must be an integer")
-        check_range(self.key(name), value, low, high)
-        return value
-
-    def string(self, name: str, choices: tuple[str, ...] | None = None, default: Any = ...) -> str:
-        value = self.raw(name, default)
-        if not isinstance(value, str):
-            raise InputError(self.key(name), value, "must be a string")
-        if choices is not None and value not in choices:
-            raise InputError(self.key(name), value, f"must be one of {', '.join(choices)}")
-        return value
-
-    def table(self, name: str, default: Any = ...) -> _Table:
-        value = self.raw(name, default)
-        return _Table(value, self.key(name))
-
-    def done(self) -> None:
-        unknown = sorted(set(self.data) - self.used)
-        if unknown:
-            raise InputError(self.key(unknown[0]), self.data[unknown[0]], "unknown key")
-
-
-# ----------------------------------------------------------------------------------------- data classes
-@dataclass(frozen=True)
-class Material:
-    """Linear elastic isotropic material (thesis Table 3.1)."""
-
-    name: str
-    youngs_modulus_Pa: float
-    poisson_ratio: float
-    density_kg_m3: float
-
-    def __post_init__(self) -> None:
-        check_range(f"materials.{self.name}.youngs_modulus_Pa", self.youngs_modulus_Pa, 0.0, low_open=True)
-        check_range(f"materials.{self.name}.poisson_ratio", self.poisson_ratio, 0.0, 0.5, high_open=True)
-        check_range(f"materials.{self.name}.density_kg_m3", self.density_kg_m3, 0.0, low_open=True)
-
-    @property
-    def shear_modulus_Pa(self) -> float:
-        return self.youngs_modulus_Pa / (2.0 * (1.0 + self.poisson_ratio))
-
-
-@dataclass(frozen=True)
-class BoxSection:
-    """Thin-walled rectangular box, outer sides ``a`` x ``b``, wall ``t`` (thesis Table 3.2, Fig 3.2).
-
-    ``a`` is taken along the bridge axis and ``b`` across it for legs; for cross beams ``a`` is the
-    width (horizontal, along the bridge) and ``b`` the depth (vertical).  Torsion by Bredt's formula on
-    the wall centre line.
-    """
-
-    a_m: float
-    b_m: float
-    t_m: float
-
-    def __post_init__(self) -> None:
-        check_range("section.a_m", self.a_m, 0.0, low_open=True)
-        check_range("section.b_m", self.b_m, 0.0, low_open=True)
-        if not (0.0 < self.t_m < 0.5 * min(self.a_m, self.b_m)):
-            raise InputError("section.t_m", self.t_m, f"must be > 0 and < half the smaller side "
-                             f"({0.5 * min(self.a_m, self.b_m):g} m)")
-
-    @property
-    def area_m2(self) -> float:
-        return self.a_m * self.b_m - (self.a_m - 2 * self.t_m) * (self.b_m - 2 * self.t_m)
-
-    @property
-    def i_about_a_m4(self) -> float:
-        """Second moment for bending with the neutral axis parallel to side ``a``: (a b^3 - a_i b_i^3)/12."""
-        ai, bi = self.a_m - 2 * self.t_m, self.b_m - 2 * self.t_m
-        return (self.a_m * self.b_m**3 - ai * bi**3) / 12.0
-
-    @property
-    def i_about_b_m4(self) -> float:
-        """Second moment for bending with the neutral axis parallel to side ``b``."""
-        ai, bi = self.a_m - 2 * self.t_m, self.b_m - 2 * self.t_m
-        return (self.b_m * self.a_m**3 - bi * ai**3) / 12.0
-
-    @property
-    def torsion_constant_m4(self) -> float:
-        """Bredt: J = 4 A_m^2 t / perimeter_m on the wall centre line."""
-        am, bm = self.a_m - self.t_m, self.b_m - self.t_m
-        return 4.0 * (am * bm) ** 2 * self.t_m / (2.0 * (am + bm))
-
-    def scaled(self, factor: float) -> BoxSection:
-        """All three dimensions times ``factor``: inertia scales as factor**4, area as factor**2."""
-        return BoxSection(self.a_m * factor, self.b_m * factor, self.t_m * factor)
-
-
-@dataclass(frozen=True)
-class Geometry:
-    """Spans, sag and levels (thesis 1.4, Table 1.2).  Elevations are above the pylon foundations.
-
-    The deck is horizontal (thesis 3.1) at ``girder_elevation_m``; the cable low point at mid-span is
-    ``pylon_height_m - sag_m``; the side-span anchors lie at that same level (Eq 2.10: y(L_s) = h).
-    """
-
-    main_span_m: float
-    side_span_m: float
-    sag_m: float
-    hanger_spacing_target_m: float
-    cable_plane_spacing_m: float
-    girder_elevation_m: float
-    pylon_height_m: float
-
-    def __post_init__(self) -> None:
-        check_range("geometry.main_span_m", self.main_span_m, 0.0, low_open=True)
-        check_range("geometry.side_span_m", self.side_span_m, 0.0, low_open=True)
-        check_range("geometry.sag_m", self.sag_m, 0.0, low_open=True)
-        check_range("geometry.sag_ratio (sag_m / main_span_m)", self.sag_m / self.main_span_m, 1 / 20, 1 / 5)
-        check_range("geometry.hanger_spacing_target_m", self.hanger_spacing_target_m, 0.0,
-                    self.main_span_m / 4, low_open=True)
-        check_range("geometry.cable_plane_spacing_m", self.cable_plane_spacing_m, 0.0, low_open=True)
-        check_range("geometry.girder_elevation_m", self.girder_elevation_m, 0.0, low_open=True)
-        if self.cable_low_point_m <= self.girder_elevation_m:
-            raise InputError("geometry.pylon_height_m", self.pylon_height_m,
-                             f"must exceed girder_elevation_m + sag_m = "
-                             f"{self.girder_elevation_m + self.sag_m:g} (cable above the deck at mid-span)")
-
-    @property
-    def cable_low_point_m(self) -> float:
-        return self.pylon_height_m - self.sag_m
-
-    @property
-    def sag_ratio(self) -> float:
-        return self.sag_m / self.main_span_m
-
-    @property
-    def total_length_m(self) -> float:
-        """Deck length L of Eq 4.5/4.34: main span plus both side spans."""
-        return self.main_span_m + 2.0 * self.side_span_m
-
-
-@dataclass(frozen=True)
-class Girder:
-    """Bridge girder (thesis Table 3.3).  i_vertical = I_yy (weak axis, vertical bending), i_lateral = I_xx,
-    torsion_constant = I_zz (St Venant), mass_moment_of_inertia = J_b (Eq 3.1)."""
-
-    area_m2: float
-    i_vertical_m4: float
-    i_lateral_m4: float
-    torsion_constant_m4: float
-    mass_per_length_kg_m: float
-    mass_moment_of_inertia_kg_m2_m: float
-    width_m: float
-    material: str
-
-
-@dataclass(frozen=True)
-class Cable:
-    """One main cable (thesis 1.4, 3.2.1).  ``allowable_stress_Pa`` is sigma_0 of Eq 1.1, the design rule
-    the up-scaling keeps (Eq 1.2)."""
-
-    area_m2: float
-    mass_per_length_main_kg_m: float
-    mass_per_length_side_kg_m: float
-    allowable_stress_Pa: float
-    material: str
-
-    @property
-    def density_kg_m3(self) -> float:
-        """rho_c = mu_c / A_c: the cable's effective density (wires, wrapping, clamps)."""
-        return self.mass_per_length_main_kg_m / self.area_m2
-
-
-@dataclass(frozen=True)
-class Hanger:
-    """Hanger pair modelled as one (thesis 3.2.2): area of both together."""
-
-    area_m2: float
-    density_kg_m3: float
-    material: str
-
-
-@dataclass(frozen=True)
-class Pylon:
-    """Concrete pylon: two vertical legs in the cable planes, joined by cross beams (thesis 3.2.3, Table 3.2).
-
-    Lower leg section from foundation to girder level, upper leg section above it.  ``extra_cross_beams``
-    are added evenly between the lower and upper cross beams in up-scaled models (thesis 1.5, Fig 1.1).
-    """
-
-    lower_leg: BoxSection
-    upper_leg: BoxSection
-    lower_cross_beam: BoxSection
-    upper_cross_beam: BoxSection
-    lower_cross_beam_elevation_m: float
-    upper_cross_beam_elevation_m: float
-    extra_cross_beams: int
-    material: str
-
-    @property
-    def cross_beam_elevations_m(self) -> tuple[float, ...]:
-        """All cross-beam levels, bottom to top, extra beams evenly spaced between lower and upper."""
-        lo, hi, n = self.lower_cross_beam_elevation_m, self.upper_cross_beam_elevation_m, self.extra_cross_beams
-        return tuple(lo + (hi - lo) * i / (n + 1) for i in range(n + 2))
-
-
-@dataclass(frozen=True)
-class DampingEntry:
-    """One row of thesis Table 3.4: measured mode, its symmetry, frequency and damping ratio."""
-
-    symmetry: str
-    frequency_hz: float
-    ratio: float
-
-
-@dataclass(frozen=True)
-class Air:
-    density_kg_m3: float = 1.225
-    kinematic_viscosity_m2_s: float = 1.48e-5
-
-
-@dataclass(frozen=True)
-class Scenario:
-    """All inputs of one run.  ``reference_name``/``scale`` say how an up-scaled bridge was made."""
-
-    name: str
-    kind: str
-    description: str
-    geometry: Geometry | None = None
-    girder: Girder | None = None
-    cable: Cable | None = None
-    hanger: Hanger | None = None
-    pylon: Pylon | None = None
-    materials: Mapping[str, Material] = field(default_factory=dict)
-    damping: tuple[DampingEntry, ...] = ()
-    air: Air = Air()
-    reference_name: str | None = None
-    pylon_inertia_ratio: float = 1.0  # I/I0 of Eq 1.3 applied when this bridge was up-scaled (1: not up-scaled)
-    source_path: str | None = None
-    flutter: Any = None   # bridge.flutter.options.FlutterOptions
-    section: Any = None   # bridge.flutter.section.SectionModel (kind == "section")
-    modal: Any = None     # bridge.flutter.modal.ModalModel given directly
-    deck_section: Any = None  # bridge.cfd.sections section (the [deck_section] table), for the aero stage
-    aero: Any = None          # bridge.aero.options.AeroOptions (the [aero] table)
-
-    # Eq 4.7 ------------------------------------------------------------------------------------------
-    @property
-    def deck_mass_per_length_kg_m(self) -> float:
-        """mu = mu_b + 2 mu_c (Eq 4.7 context, Table 3.6): girder plus both main cables."""
-        return self.girder.mass_per_length_kg_m + 2.0 * self.cable.mass_per_length_main_kg_m
-
-    @property
-    def deck_inertia_per_length_kg_m2_m(self) -> float:
-        """J = J_b + (B^2/2) mu_c (Eq 4.7), B the distance between the cable planes."""
-        b = self.geometry.cable_plane_spacing_m
-        return self.girder.mass_moment_of_inertia_kg_m2_m + 0.5 * b * b * self.cable.mass_per_length_main_kg_m
-
-    def material(self, name: str) -> Material:
-        return self.materials[name]
-
-    def with_main_span(self, main_span_m: float) -> Scenario:
-        from .upscaling import upscale  # local import: upscaling needs this module
-
-        return upscale(self, main_span_m)
 
 
 # ----------------------------------------------------------------------------------------- parsing
 _KINDS = ("suspension_bridge", "section", "modal")
 
 
-def _box(t: _Table, name: str) -> BoxSection:
+def _box(t: Table, name: str) -> BoxSection:
     s = t.table(name)
     try:
         box = BoxSection(s.number("a_m"), s.number("b_m"), s.number("t_m"))
@@ -343,7 +71,7 @@ def _box(t: _Table, name: str) -> BoxSection:
     return box
 
 
-def _air(t: _Table) -> Air:
+def _air(t: Table) -> Air:
     """The optional [air] table (thesis 5.2.4 values as defaults)."""
     a = t.table("air", default={})
     air = Air(a.number("density_kg_m3", default=Air.density_kg_m3),
@@ -352,7 +80,7 @@ def _air(t: _Table) -> Air:
     return air
 
 
-def _materials(t: _Table) -> dict[str, Material]:
+def _materials(t: Table) -> dict[str, Material]:
     out = {}
     for name in t.data:
         m = t.table(name)
@@ -364,14 +92,14 @@ def _materials(t: _Table) -> dict[str, Material]:
     return out
 
 
-def _material_name(t: _Table, materials: Mapping[str, Material]) -> str:
+def _material_name(t: Table, materials: Mapping[str, Material]) -> str:
     name = t.string("material")
     if name not in materials:
         raise InputError(t.key("material"), name, f"must be one of the [materials] tables: {', '.join(materials)}")
     return name
 
 
-def _parse_bridge(t: _Table, name: str, description: str, source: str | None) -> Scenario:
+def _parse_bridge(t: Table, name: str, description: str, source: str | None) -> Scenario:
     materials = _materials(t.table("materials"))
 
     g = t.table("geometry")
@@ -423,7 +151,7 @@ def _parse_bridge(t: _Table, name: str, description: str, source: str | None) ->
         raise InputError(d.key("modes"), rows, "must be a non-empty list of {symmetry, frequency_hz, ratio}")
     damping = []
     for i, row in enumerate(rows):
-        r = _Table(row, f"damping.modes[{i}]")
+        r = Table(row, f"damping.modes[{i}]")
         damping.append(DampingEntry(r.string("symmetry", ("S", "SS")), r.number("frequency_hz"),
                                     r.number("ratio", 0.0, 0.2, low_open=False)))
         r.done()
@@ -436,7 +164,7 @@ def _parse_bridge(t: _Table, name: str, description: str, source: str | None) ->
                     damping=tuple(damping), air=air, source_path=source)
 
 
-def _parse_optional_tables(t: _Table, scenario: Scenario) -> Scenario:
+def _parse_optional_tables(t: Table, scenario: Scenario) -> Scenario:
     """[flutter], [section] and [modal] tables belong to the flutter package, [deck_section] to
     bridge.cfd.sections and [aero] to bridge.aero; each validates its own."""
     updates: dict[str, Any] = {}
@@ -639,7 +367,7 @@ def load_scenario(name_or_path: str | Path, main_span_m: float | None = None,
     data = _read_toml(path)
     if "reference" not in data:
         data = apply_overrides(data, overrides or {})
-    t = _Table(data, "")
+    t = Table(data, "")
     if "name" in data:
         name = check_name(t.string("name"))
     else:  # the file's own name: a copy saved under another name writes to its own folder
@@ -650,7 +378,7 @@ def load_scenario(name_or_path: str | Path, main_span_m: float | None = None,
         t.string("reference")
         span = t.number("main_span_m")
         tables, ref_name = _resolved_reference(path, (name,))
-        merged = _Table(apply_overrides(tables, overrides or {}), "")
+        merged = Table(apply_overrides(tables, overrides or {}), "")
         merged.used.add("kind")   # checked by _resolved_reference: a suspension bridge
         reference = _parse_bridge(merged, ref_name, description, str(path))
         reference = _parse_optional_tables(merged, reference)
@@ -660,7 +388,7 @@ def load_scenario(name_or_path: str | Path, main_span_m: float | None = None,
         target = main_span_m if main_span_m is not None else span
         if main_span_m is not None and not math.isclose(main_span_m, span):
             name = f"{name}_L{main_span_m:g}"
-        scenario = reference.with_main_span(target)
+        scenario = upscale(reference, target)
         scenario = replace(scenario, name=name, description=description or scenario.description,
                            source_path=str(path))
         return _checked(scenario)
@@ -682,7 +410,7 @@ def load_scenario(name_or_path: str | Path, main_span_m: float | None = None,
     scenario = _parse_optional_tables(t, scenario)
     t.done()
     if main_span_m is not None and not math.isclose(main_span_m, scenario.geometry.main_span_m):
-        scenario = replace(scenario.with_main_span(main_span_m), name=f"{name}_L{main_span_m:g}")
+        scenario = replace(upscale(scenario, main_span_m), name=f"{name}_L{main_span_m:g}")
     return _checked(scenario)
 
 

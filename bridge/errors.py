@@ -1,14 +1,18 @@
 """Errors that reach the user as one clear line.
 
 ``InputError`` names the input key, the value given and the allowed range; the command line turns it
-into exit status 2.  ``ConvergenceError`` says which iteration failed and its last residual.
+into exit status 2.  ``ConvergenceError`` says which iteration failed and its last residual (exit status 3).
+``InternalError`` is a broken invariant of the program itself: a bug, never the user's input, and it says so.
+Functions of the library (bridge.cfd, ...) called with a bad argument raise ``ValueError`` naming the argument;
+the program checks every user input before it calls them, so that what reaches a user as ``ValueError`` is a
+bug too (the command line then shows its traceback).
 """
 
 from __future__ import annotations
 
 import math
 
-__all__ = ["InputError", "ConvergenceError", "check_range"]
+__all__ = ["InputError", "ConvergenceError", "DivergedError", "InternalError", "check_range"]
 
 
 class InputError(ValueError):
@@ -46,6 +50,18 @@ class DivergedError(ConvergenceError):
 
     def __reduce__(self):
         return type(self), (self.what, self.detail)
+
+
+class InternalError(RuntimeError):
+    """A broken invariant of the program (a bug): what broke, and a request to report it."""
+
+    def __init__(self, what: str):
+        self.what = what
+        super().__init__(f"internal error (a bug in bridge, not in your input; please report it with the command "
+                         f"that gave it): {what}")
+
+    def __reduce__(self):
+        return type(self), (self.what,)
 
 
 def check_range(key: str, value: float, low: float | None = None, high: float | None = None,

@@ -102,7 +102,7 @@ def _epilog() -> str:
             f"exit status:\n{codes}\n\nresult schema: docs/results.md")
 
 
-def _parser() -> argparse.ArgumentParser:
+def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="python -m bridge.scenario", description=__doc__.split("\n\n")[1],
                                 epilog=_epilog(), formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("scenarios", nargs="+", metavar="NAME_OR_PATH",
@@ -146,7 +146,7 @@ def parse_stages(text: str | None) -> list[str] | None:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    args = _parser().parse_args(argv)
+    args = build_parser().parse_args(argv)
     say = (lambda m: None) if args.quiet else (lambda m: print(m, file=sys.stderr, flush=True))
     written: list[Path] = []
     with Interrupts() as interrupts:

@@ -9,13 +9,17 @@ Stages never write files themselves; :mod:`bridge.results` writes everything ato
 
 from __future__ import annotations
 
+import hashlib
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import cache
 from importlib import import_module
+from importlib.util import find_spec
 from pathlib import Path
 from typing import Any
 
-__all__ = ["StageOutput", "RunOptions", "Stage", "STAGES", "IDENTITY_FIELDS", "resolve_stage"]
+__all__ = ["StageOutput", "RunOptions", "Stage", "STAGES", "IDENTITY_FIELDS", "resolve_stage", "code_digest",
+           "CFD_KERNELS"]
 
 
 @dataclass
@@ -116,3 +120,22 @@ def resolve_stage(name: str) -> Callable[..., StageOutput]:
         raise KeyError(f"unknown stage {name!r}; known stages: {', '.join(STAGES)}")
     module_name, func_name = STAGES[name].target.split(":")
     return getattr(import_module(module_name), func_name)
+
+
+@cache
+def code_digest(modules: tuple[str, ...]) -> str:
+    """SHA-256 over the source files of the given modules and packages (packages: every .py inside): what a
+    cached stage result or a CFD checkpoint must match to be reused (a changed code never reuses old results)."""
+    h = hashlib.sha256()
+    for name in modules:
+        spec = find_spec(name)
+        if spec is None:
+            raise KeyError(f"stage code {name!r} is not an importable module")
+        if spec.submodule_search_locations:
+            files = sorted(p for loc in spec.submodule_search_locations for p in Path(loc).rglob("*.py"))
+        else:
+            files = [Path(spec.origin)]
+        for f in files:
+            h.update(f.name.encode())
+            h.update(f.read_bytes())
+    return h.hexdigest()

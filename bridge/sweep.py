@@ -326,7 +326,7 @@ def run_sweep(cases: list[Case], sweep_dir: Path, stages: list[str] | None = Non
     return status
 
 
-def _parser() -> argparse.ArgumentParser:
+def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="python -m bridge.sweep", description=__doc__.split("\n\n")[0],
                                 epilog="exit status: 0 done; 1 some cases failed (listed); 2 bad input, nothing "
                                        "run; 130 interrupted (finished cases kept)")
@@ -354,7 +354,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     from .pipeline import plan_stages
     from .scenario import parse_stages
 
-    args = _parser().parse_args(argv)
+    args = build_parser().parse_args(argv)
     say = lambda m: print(m, file=sys.stderr, flush=True)  # noqa: E731
     sweep_dir = None
     with Interrupts() as interrupts:

@@ -18,7 +18,7 @@ Rules, each computed from the reference scenario and the target span L (never ty
 * Extra cross beams (Fig 1.1): the thesis adds one in Model B (3000 m) and two in Model C (4000 m), evenly
   spaced.  It states no rule; generalised here as one extra beam per full 1000 m of main span beyond
   2000 m (gives 0, 1, 2 for Models A, B, C).
-* mu and J of Eq 4.7 follow from the scaled cable mass (properties of :class:`bridge.config.Scenario`).
+* mu and J of Eq 4.7 follow from the scaled cable mass (properties of :class:`bridge.inputs.Scenario`).
 """
 
 from __future__ import annotations
@@ -26,8 +26,8 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 
-from .config import GRAVITY_M_S2, Geometry, Pylon, Scenario
 from .errors import InputError, check_range
+from .inputs import GRAVITY_M_S2, Geometry, Pylon, Scenario
 
 __all__ = ["upscale", "cable_area_for_span", "span_limit_m", "pylon_inertia_ratio", "extra_cross_beams"]
 

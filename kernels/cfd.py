@@ -535,10 +535,10 @@ def ib_targets(q: wp.array2d(dtype=wp.float64), phi: wp.array2d(dtype=wp.float64
     when the reference face lies in the viscous sublayer), on lines that meet the wall nearly square
     (within 45 degrees of its normal, ``square_to_wall``). The component along the line, which meets
     the wall, keeps the straight line: the law of the wall is a tangential profile, and applied to the
-    normal velocity of a moving deck it made its heave damping change sign (docs/aero.md). So does the
+    normal velocity of a moving deck it made its heave damping change sign. So does the
     component across a line that meets an inclined wall obliquely: there it is mostly the normal
     velocity (v on a horizontal line against the deck's 28-degree bottom panels), and the wall law on it
-    let the flow through the wall at the trailing edge until the run diverged (docs/aero.md).
+    let the flow through the wall at the trailing edge until the run diverged.
     ``wall_law`` 2: the same law blended with the linear profile, r = r_lin + w (r_law - r_lin), by the
     reference face's eddy viscosity against the law's own there (``nu_eff``: the flow's nu + nu_t, cells;
     w = min(1, 2 (nu_eff - nu) / nu_t,law), nu_t,law = nu (dy+/du+ - 1), ``kernels.wall_law``): where the layer

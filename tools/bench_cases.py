@@ -18,15 +18,14 @@ import argparse
 import json
 import sys
 import time
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from bridge.aero.forced_motion import QUALITY, StaticCase, preset, run_cases  # noqa: E402
-from bridge.aero.stage import _unit_polygons  # noqa: E402
+from bridge.aero.forced_motion import StaticCase, run_cases  # noqa: E402
+from bridge.aero.presets import QUALITY, preset, section_polygons  # noqa: E402
 from bridge.cfd.sections import great_belt_section  # noqa: E402
 
 
@@ -50,10 +49,10 @@ def main(argv=None) -> int:
 
     wp.config.quiet = True
     section = great_belt_section()
-    q = replace(preset(args.quality, args.grid), static_duration=args.duration)
+    q = preset(args.quality, args.grid).with_(static_duration=args.duration)
     if args.turbulence == "sst":
-        q = replace(q, turbulence="sst", reynolds=50.0 * section.chord_m / 1.48e-5)
-    polys = _unit_polygons(section)
+        q = q.with_(turbulence="sst", reynolds=50.0 * section.chord_m / 1.48e-5)
+    polys = section_polygons(section)
     angles = np.linspace(-2.0, 2.0, args.cases)
     jobs = [(StaticCase(float(a), 2.0), None, f"{a:+.2f} deg") for a in angles]
     run_cases(polys, jobs[:1], q, workers=1)   # compile and warm the kernels here first

@@ -108,28 +108,28 @@ def bench_warp(sim, repeats, steps, device=None):
     L = sim.L
     rhs0 = np.random.default_rng(1).standard_normal((ny, nx))
     rhs0 -= rhs0.mean()
-    rhs_buf = sim.rhs.numpy() if sim._host else None
+    rhs_buf = sim.rhs.numpy() if sim.L.device.is_cpu else None
     nb = sim.n_blocks
     pred = [sim.hy_c, sim.hy_f, sim.grid.dx, dt, 0.5, 0.5]
     frame = [sim.frame_x, sim.frame_xf, sim.frame_y, sim.frame_yu, sim.frame_omega]
     parts = {
         "predict_u": lambda: L.rows(kc.predict_u, nb, 0, [sim.u, sim.v, sim.p, sim.nu, sim.u, sim.u_star, *pred,
                                                           g + 1, g + nx, g, ny, nb, 0, sim.scheme, ROW0,
-                                                          sim._scratch, *frame], min_split=2),
+                                                          sim.yflux_scratch, *frame], min_split=2),
         "predict_v": lambda: L.rows(kc.predict_v, nb, 0, [sim.u, sim.v, sim.p, sim.nu, sim.v, sim.v_star, *pred,
                                                           g, g + nx, g + 1, ny - 1, nb, 0, sim.scheme, ROW0,
-                                                          sim._scratch, *frame], min_split=2),
+                                                          sim.yflux_scratch, *frame], min_split=2),
         "boundaries": lambda: sim.bc.set_normal_faces(sim.u, sim.u, sim.u_star, sim.t, dt, 0.5, 0.5),
         "divergence": lambda: L.rows(kc.divergence, ny, 0, [sim.u_star, sim.v_star, sim.hy_c, sim.grid.dx,
                                                             1.0, g, nx, ROW0, sim.rhs]),
         # a fresh right-hand side every call (the in-place solve would otherwise re-solve its own output);
         # the copy (~0.3 ns/cell) is included in the figure
-        "poisson": lambda: sim.poisson.solve_inplace(np.copyto(rhs_buf, rhs0) or rhs_buf) if sim._host
+        "poisson": lambda: sim.poisson.solve_inplace(np.copyto(rhs_buf, rhs0) or rhs_buf) if sim.L.device.is_cpu
         else sim.rhs.assign(sim.poisson.solve(rhs0)),
         "project": lambda: L.rows(kc.project, ny, 0, [sim.u_star, sim.v_star, sim.rhs, sim.hy_f, sim.grid.dx,
-                                                      0.5 * dt, g, nx, ny, 0, ROW0, sim.u_stage, sim.v_stage,
+                                                      0.5 * dt, g, nx, ny, 0, ROW0, sim.u_sub, sim.v_sub,
                                                       sim.p]),
-        "ghosts": lambda: sim.bc.fill_ghosts(sim.u_stage, sim.v_stage),
+        "ghosts": lambda: sim.bc.fill_ghosts(sim.u_sub, sim.v_sub),
     }
     for name, fn in parts.items():
         fn()

@@ -33,7 +33,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 import warp as wp  # noqa: E402
 from bench_overset import grid_shape  # noqa: E402  (tools/ is on the path: the script's own folder)
 
-from bridge.cfd import BoundaryConditions, CartesianGrid, FlowConfig, Simulation  # noqa: E402
+from bridge.cfd import LAMINAR, BoundaryConditions, CartesianGrid, FlowConfig, Simulation  # noqa: E402
 from bridge.cfd.turbulence import KOmegaSST, freestream_turbulence  # noqa: E402
 
 
@@ -59,21 +59,21 @@ def main(argv=None) -> int:
 
         sim.add_body(box_deck(1.0, 0.1), HarmonicMotion(2.0, 1.0, (0.0, 0.02, 0.02), 0.8))
     sim.set_state(u=1.0)
-    model = KOmegaSST(sim, *freestream_turbulence(1.0, nu, 0.05, 10.0))
-    dt = 0.5 * min(sim.stable_dt(), model.stable_dt())
+    model = KOmegaSST(sim, *freestream_turbulence(1.0, nu, 0.05, 10.0))   # the simulation owns and advances it
+    dt = 0.5 * sim.stable_dt()
     for _ in range(20):
         sim.step(dt)
-        model.advance(dt)
     flow, both = [], []
     for _ in range(args.repeats):
+        sim.use_turbulence(LAMINAR)   # the same flow with its model set aside
         t0 = time.perf_counter()
         for _ in range(args.steps):
             sim.step(dt)
         flow.append((time.perf_counter() - t0) / args.steps)
+        sim.use_turbulence(model)
         t0 = time.perf_counter()
         for _ in range(args.steps):
             sim.step(dt)
-            model.advance(dt)
         both.append((time.perf_counter() - t0) / args.steps)
     cells = nx * ny
     ratio = float(np.median(np.array(both) / np.array(flow)))
@@ -94,27 +94,25 @@ def main(argv=None) -> int:
 
 def _overset(args) -> int:
     """Blocks of the pair's step without and with its SST model (module doc)."""
-    from dataclasses import replace
-
-    from bridge.aero.forced_motion import QUICK_UNTIL_2026_12_02, ForcedCase, _overset_flow
-    from bridge.aero.stage import _unit_polygons
+    from bridge.aero.forced_motion import ForcedCase
+    from bridge.aero.presets import SHORT_DOMAIN_40, build_flow, section_polygons
     from bridge.cfd.sections import great_belt_section
 
-    # the pair of docs/performance.md: 40 cells per chord on a 2 / 10 / 2 chord domain
-    q = replace(QUICK_UNTIL_2026_12_02, overset=True, turbulence="sst", reynolds=1.05e8)
-    pair = _overset_flow(q, _unit_polygons(great_belt_section()), ForcedCase.thesis("heave", 0.5), None)
-    model = pair.model
+    # the pair of docs/performance.md: 40 cells per chord on the short 2 / 10 / 2 chord domain
+    q = SHORT_DOMAIN_40.with_(overset=True, turbulence="sst", reynolds=1.05e8)
+    pair = build_flow(q, section_polygons(great_belt_section()), ForcedCase.thesis("heave", 0.5))
+    model = pair.turbulence
     dt = pair.stable_dt()
     for _ in range(20):
         pair.step(dt)
     flow, both = [], []
     for _ in range(args.repeats):
-        pair.model = None
+        pair.use_turbulence(LAMINAR)
         t0 = time.perf_counter()
         for _ in range(args.steps):
             pair.step(dt)
         flow.append((time.perf_counter() - t0) / args.steps)
-        pair.model = model
+        pair.use_turbulence(model)
         t0 = time.perf_counter()
         for _ in range(args.steps):
             pair.step(dt)

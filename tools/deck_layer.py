@@ -1,5 +1,5 @@
 """The Great Belt deck's boundary layers over its top and under its bottom: laminar, turbulent, short of the
-log layer, or reversed (docs/aero.md, "The deck's own boundary layer" and "A layer turbulent from the nose").
+log layer, or reversed (docs/aero.md, "Grid study"; docs/cfd.md, "Turbulence model and walls").
 
     python tools/deck_layer.py [--section great_belt|plate] [--nose-height F] [--bottom-flat F]
                                [--quality quick] [--cells-per-chord N] [--background-coarsening M]
@@ -62,8 +62,9 @@ from reynolds_study import NU_AIR  # noqa: E402
 from validate_turbulence import BETA_STAR, KAPPA, spalding_uplus_from_re  # noqa: E402
 from validate_turbulence import B as B_LOG  # noqa: E402
 
-from bridge.aero.forced_motion import QUALITY, SST_WALLS, StaticCase, preset, run_case  # noqa: E402
-from bridge.aero.stage import _unit_polygon, _unit_polygons  # noqa: E402
+from bridge.aero.forced_motion import StaticCase, run_case  # noqa: E402
+from bridge.aero.presets import QUALITY, SST_WALLS, preset  # noqa: E402
+from bridge.aero.presets import section_polygons as unit_polygons  # noqa: E402
 from bridge.aero.static import chordwise_loading  # noqa: E402
 from bridge.cfd.grids import GHOST  # noqa: E402
 from bridge.cfd.sections import FlatPlate, great_belt_section  # noqa: E402
@@ -134,19 +135,19 @@ def section_polygons(name: str, nose_height: float | None = None, bottom_flat: f
     0.6 (smaller: longer, shallower inclined bottom panels; the rear one rises at 28 degrees by default, at
     17 degrees with 0.3)."""
     if name == "plate":
-        return [_unit_polygon(FlatPlate(1.0, PLATE_THICKNESS))]
+        return unit_polygons(FlatPlate(1.0, PLATE_THICKNESS))[:1]
     deck = great_belt_section()
     if nose_height is not None:
         deck = replace(deck, nose_height_fraction=nose_height)
     if bottom_flat is not None:
         deck = replace(deck, bottom_flat_fraction=bottom_flat)
-    return _unit_polygons(deck)
+    return unit_polygons(deck)
 
 
 def deck_layer(q, angle_deg: float, threads: int | None, polys: list, section: str = "great_belt") -> dict:
     """The section ``polys`` (unit chord, ``section`` names it in the progress) held at ``angle_deg`` on ``q``
     (an overset SST preset); the layer over its top (module doc), and under its bottom as ``"bottom"``."""
-    average = _FieldAverage(0.5 * q.static_duration)
+    average = _FieldAverage(0.5 * q.run.static_duration)
     rec = run_case(polys, StaticCase(angle_deg), q, progress=_say, label=f"{section} at {angle_deg:g} deg",
                    threads=threads, observe=average)
     flow = average.flow
@@ -156,8 +157,9 @@ def deck_layer(q, angle_deg: float, threads: int | None, polys: list, section: s
     forced = np.zeros((grid.ny, grid.nx), dtype=bool)
     for body in flow.body.bodies:
         forced |= body.forced_cells()
-    fields = {"nut": average.mean("nu")[inner] - 1.0 / q.reynolds, "u": 0.5 * (u_faces[:, :-1] + u_faces[:, 1:]),
-              "forced": forced, "omega": flow.model.body.omega.q.numpy()[inner]}
+    fields = {"nut": average.mean("nu")[inner] - 1.0 / q.physics.reynolds,
+              "u": 0.5 * (u_faces[:, :-1] + u_faces[:, 1:]),
+              "forced": forced, "omega": flow.turbulence.body.omega.q.numpy()[inner]}
     # the pressure's level is free: measured from its mean over the body grid's outermost ring of cells (the
     # body grid's margin beyond the deck, 0.35 B on standard and fine, 0.375 B on quick; the same ring seen
     # from beneath), so that the sides' pressures compare between grids
@@ -167,13 +169,13 @@ def deck_layer(q, angle_deg: float, threads: int | None, polys: list, section: s
     # the side below, seen from beneath: the rows and the heights mirrored, the chordwise speed unchanged
     below = {name: a[::-1] for name, a in fields.items()}
     mirrored = [p.vertices * np.array([1.0, -1.0]) for p in polys]
-    second = rec.t > 0.5 * q.static_duration   # per rho V^2 B (B^2): twice the coefficients
+    second = rec.t > 0.5 * q.run.static_duration   # per rho V^2 B (B^2): twice the coefficients
     forces = {name: float(2.0 * getattr(rec, force)[second].mean())
               for name, force in (("C_L", "lift"), ("C_D", "drag"), ("C_M", "moment"))}
     record_t = np.arange(0.0, float(rec.t[-1]) + 1e-9, RECORD_STEP)
     record = 2.0 * np.interp(record_t, rec.t, rec.lift)
-    top = layer_along(fields, grid.y_centres, grid.x_centres, [p.vertices for p in polys], q.reynolds)
-    bottom = layer_along(below, -grid.y_centres[::-1], grid.x_centres, mirrored, q.reynolds)
+    top = layer_along(fields, grid.y_centres, grid.x_centres, [p.vertices for p in polys], q.physics.reynolds)
+    bottom = layer_along(below, -grid.y_centres[::-1], grid.x_centres, mirrored, q.physics.reynolds)
     return {**forces, **top, "bottom": bottom, **pressure_loads(top, bottom, grid.dx),
             "cells": rec.meta["cells"], "grids": rec.meta["grids"], "wall_s": rec.wall_s, "steps": rec.steps,
             "C_L_record": [round(float(c), 6) for c in record]}
@@ -320,14 +322,14 @@ def main(argv=None) -> int:
             ap.error(f"{name}: {value:g} not allowed; must be {allowed}")
     section = great_belt_section()
     try:
-        q = replace(preset(args.quality, "overset"), turbulence="sst", reynolds=args.speed * section.chord_m / NU_AIR,
+        q = preset(args.quality, "overset").with_(turbulence="sst", reynolds=args.speed * section.chord_m / NU_AIR,
                     sst_walls=args.sst_walls, static_duration=args.duration)
         if args.cells_per_chord is not None:
-            q = replace(q, cells_per_chord=args.cells_per_chord)
+            q = q.with_(cells_per_chord=args.cells_per_chord)
         if args.background_coarsening is not None:
-            q = replace(q, background_coarsening=args.background_coarsening)
+            q = q.with_(background_coarsening=args.background_coarsening)
         if args.body_margin is not None:
-            q = replace(q, body_margin=args.body_margin)
+            q = q.with_(body_margin=args.body_margin)
         for option, value in (("--nose-height", args.nose_height), ("--bottom-flat", args.bottom_flat)):
             if value is not None and args.section != "great_belt":
                 raise InputError(option, value, "applies to --section great_belt only")
@@ -338,12 +340,12 @@ def main(argv=None) -> int:
     got = deck_layer(q, args.angle, args.threads, polys, args.section)
     result = {"section": args.section, "nose_height_fraction": args.nose_height,
               "bottom_flat_fraction": args.bottom_flat, "angle_deg": args.angle,
-              "speed_m_s": args.speed, "reynolds": q.reynolds, "quality": args.quality,
-              "cells_per_chord": q.cells_per_chord, "background_coarsening": q.background_coarsening,
-              "body_margin": q.body_margin,
+              "speed_m_s": args.speed, "reynolds": q.physics.reynolds, "quality": args.quality,
+              "cells_per_chord": q.grid.cells_per_chord, "background_coarsening": q.grid.background_coarsening,
+              "body_margin": q.grid.body_margin,
               "sst_walls": args.sst_walls, "duration": args.duration, **got}
-    print(f"{args.section} at {args.angle:g} deg, Re {q.reynolds:.3g}, {args.quality} "
-          f"({q.cells_per_chord} cells per chord, background x{q.background_coarsening}), "
+    print(f"{args.section} at {args.angle:g} deg, Re {q.physics.reynolds:.3g}, {args.quality} "
+          f"({q.grid.cells_per_chord} cells per chord, background x{q.grid.background_coarsening}), "
           f"SST walls {args.sst_walls}; second half of {args.duration:g} B/V")
     print("  C_L {C_L:+.4f}   C_D {C_D:.4f}   C_M {C_M:+.4f}   (means over the second half)".format(**got))
     print("  from the first free cells' pressure: C_N {C_N_pressure:+.4f}   C_M {C_M_pressure:+.4f}".format(**got))

@@ -22,7 +22,7 @@ Above the upper side it also gives, along the chord, the largest eddy viscosity 
 of the surface and the velocity along the chord in the first cell off the wall (ours: the first no forcing
 touches; OpenFOAM's: the face's own cell), time-averaged as the pressure (OpenFOAM's: at its last time): where a
 code's boundary layer is laminar, turbulent or reversed.  ``--sst-walls`` chooses our SST's treatment of the
-plate's walls (``Quality.sst_walls``): "function" (default here, the documented plate runs': Spalding's wall
+plate's walls (``Physics.sst_walls``): "function" (default here, the documented plate runs': Spalding's wall
 function with the model's production of k), "blended", the wall function only where the layer is turbulent,
 "equilibrium", the wall function with the log layer's own production of k (the layer turbulent from the
 leading edge; the aero stage's default), or "resolved" (a diagnostic: at Re 1e6 the first cells lie far above
@@ -37,7 +37,6 @@ import argparse
 import json
 import math
 import sys
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -45,8 +44,8 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from bridge.aero.forced_motion import SST_WALLS, StaticCase, run_case  # noqa: E402
-from bridge.aero.stage import _unit_polygon  # noqa: E402
+from bridge.aero.forced_motion import StaticCase, run_case  # noqa: E402
+from bridge.aero.presets import SST_WALLS, section_polygons  # noqa: E402
 from bridge.aero.static import chordwise_loading  # noqa: E402
 from bridge.cfd.grids import GHOST  # noqa: E402
 from bridge.cfd.sections import FlatPlate  # noqa: E402
@@ -105,8 +104,8 @@ def surface_rows(forced: np.ndarray, y_centres: np.ndarray, columns: np.ndarray)
 def our_loading(angle_deg: float, quality, thickness: float, threads: int | None) -> dict:
     """The plate held at ``angle_deg`` on ``quality`` (an overset preset); the loading, the eddy viscosity above
     the upper side (:func:`upper_side_flow`) and the force record's coefficients over the last quarter."""
-    poly = _unit_polygon(FlatPlate(1.0, thickness))
-    average = _FieldAverage(0.75 * quality.static_duration)
+    poly = section_polygons(FlatPlate(1.0, thickness))[0]
+    average = _FieldAverage(0.75 * quality.run.static_duration)
     rec = run_case(poly, StaticCase(angle_deg), quality, progress=_say, label=f"plate at {angle_deg:g} deg",
                    threads=threads, observe=average)
     flow = average.flow
@@ -119,7 +118,7 @@ def our_loading(angle_deg: float, quality, thickness: float, threads: int | None
     delta = (p[down, columns] - p[up, columns]) / 0.5
     x = grid.x_centres[columns] + 0.5
     u_faces = average.mean("u")[GHOST:GHOST + grid.ny, GHOST:GHOST + grid.nx + 1]
-    upper = upper_side_flow(average.mean("nu")[inner] * quality.reynolds - 1.0,
+    upper = upper_side_flow(average.mean("nu")[inner] * quality.physics.reynolds - 1.0,
                             0.5 * (u_faces[:, :-1] + u_faces[:, 1:]), grid.y_centres, columns, up, thickness / 2)
     loading = chordwise_loading(x, delta, np.full(x.size, grid.dx), math.radians(angle_deg))
     sel = rec.t > 0.75 * rec.t[-1]
@@ -235,22 +234,22 @@ def main(argv=None) -> int:
     try:
         q = plate_quality(args.quality, "overset", args.turbulence, args.reynolds,
                           {"cells_per_chord": args.cells_per_chord, "dy_over_dx": args.dy_over_dx}, args.sst_walls)
-        q = replace(q, static_duration=args.duration)
+        q = q.with_(static_duration=args.duration)
         check_output_root(args.out)
     except (InputError, KeyError, ValueError) as err:
         ap.error(str(err))
     ours = our_loading(args.angle, q, args.thickness, args.threads)
     loading = ours["loading"]
     result = {"angle_deg": args.angle, "turbulence": args.turbulence, "reynolds": args.reynolds,
-              "thickness": args.thickness, "quality": args.quality, "cells_per_chord": q.cells_per_chord,
-              "dy_over_dx": q.dy_over_dx, "sst_walls": args.sst_walls,
+              "thickness": args.thickness, "quality": args.quality, "cells_per_chord": q.grid.cells_per_chord,
+              "dy_over_dx": q.grid.dy_over_dx, "sst_walls": args.sst_walls,
               "duration": args.duration, "cells": ours["cells"], "grids": ours["grids"], "wall_s": ours["wall_s"],
               "sample_height_cells": ours["sample_height_cells"], "ours": loading.as_dict(),
               "ours_force_record": ours["record"], "ours_delta_cp": {"x": ours["x"].tolist(),
                                                                      "delta_cp": ours["delta_cp"].tolist()},
               "ours_upper_side": _listed(ours["upper_side"])}
-    print(_row(f"ours ({q.cells_per_chord} cells per chord)", loading, ours["record"]))
-    curves = [(f"ours, {q.cells_per_chord} cells per chord", ours["x"], ours["delta_cp"])]
+    print(_row(f"ours ({q.grid.cells_per_chord} cells per chord)", loading, ours["record"]))
+    curves = [(f"ours, {q.grid.cells_per_chord} cells per chord", ours["x"], ours["delta_cp"])]
     rows = [("ours", loading)]
     sides = [("ours", ours["upper_side"])]
     if args.openfoam is not None:

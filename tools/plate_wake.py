@@ -1,5 +1,5 @@
 """The wake behind a heaving thin plate in the CFD, and what its measured speed and growth do to the lift in a
-thin-aerofoil model (docs/aero.md, "What the miss at U/(fB) = 4 is not").
+thin-aerofoil model (docs/validation.md, the notes on the plate's rows).
 
     python tools/validate_aero.py ...          # the derivatives against Theodorsen
     python tools/plate_wake.py --reduced-velocities 4 8 [--quality standard] [--grid overset] [--out DIR]
@@ -38,10 +38,10 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from validate_aero import plate_quality  # noqa: E402
 
-from bridge.aero.forced_motion import ForcedCase, _overset_flow, _SingleGridFlow  # noqa: E402
+from bridge.aero.forced_motion import ForcedCase  # noqa: E402
 from bridge.aero.frequency_response import forced_motion_response  # noqa: E402
+from bridge.aero.presets import build_flow, section_polygons  # noqa: E402
 from bridge.aero.snapshots import cell_centred  # noqa: E402
-from bridge.aero.stage import _unit_polygon  # noqa: E402
 from bridge.cfd.grids import GHOST  # noqa: E402
 from bridge.cfd.sections import FlatPlate  # noqa: E402
 from bridge.flutter.aerodynamics import Theodorsen  # noqa: E402
@@ -121,13 +121,13 @@ def sample_wake(reduced_velocity: float, quality: str, grid: str, periods: int =
     K = 2 * math.pi / reduced_velocity
     T = 2 * math.pi / K
     q = plate_quality(quality, grid)
-    cells_across = 0.02 * q.cells_per_chord / q.dy_over_dx
+    cells_across = 0.02 * q.grid.cells_per_chord / q.grid.dy_over_dx
     if cells_across < 2.0:   # as the aero stage warns: the immersed boundary barely sees the plate
         say(f"WARNING: the 2 % plate is {cells_across:.1f} cells thick on the {quality!r} grid (fewer than 2): "
             "its loads and wake are not to be trusted")
-    polys = [_unit_polygon(FlatPlate(1.0, 0.02))]
+    polys = [section_polygons(FlatPlate(1.0, 0.02))[0]]
     case = ForcedCase.thesis("heave", K)
-    flow = _overset_flow(q, polys, case, None) if q.overset else _SingleGridFlow(q, polys, case, None)
+    flow = build_flow(q, polys, case)
     fixed = flow.simulations[0]
     g = GHOST
     xc, yc = np.asarray(fixed.grid.x_centres), np.asarray(fixed.grid.y_centres)

@@ -31,18 +31,9 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from bridge.aero.forced_motion import (  # noqa: E402
-    QUALITY,
-    SST_WALLS,
-    ForcedCase,
-    Quality,
-    checkpoint_path,
-    preset,
-    run_case,
-    whole_periods,
-)
+from bridge.aero.forced_motion import ForcedCase, checkpoint_path, run_case, whole_periods  # noqa: E402
 from bridge.aero.frequency_response import forced_motion_response  # noqa: E402
-from bridge.aero.stage import _unit_polygons  # noqa: E402
+from bridge.aero.presets import QUALITY, SST_WALLS, Physics, preset, section_polygons  # noqa: E402
 from bridge.cfd.sections import great_belt_section  # noqa: E402
 
 RHO, NU_AIR = 1.225, 1.48e-5   # thesis 5.2.4
@@ -58,12 +49,13 @@ def run_speed(speed: float, omega: float, quality: str, turbulence: str, runs: P
     """Heave and pitch at one speed; ``changes``: fields of the preset to replace (a grid study's
     cells_per_chord, cfl); ``threads``: of each case (None: run_case's choice)."""
     section = great_belt_section()
-    polys = _unit_polygons(section)
-    q = replace(preset(quality, grid), **changes)
+    polys = section_polygons(section)
+    q = preset(quality, grid).with_(**changes)
     if turbulence != "laminar":
-        q = replace(q, turbulence=turbulence, reynolds=speed * section.chord_m / NU_AIR)
-    row: dict = {"speed_m_s": speed, "reynolds": q.reynolds, "turbulence": q.turbulence, "quality": quality,
-                 "grid": grid, **({"sst_walls": q.sst_walls} if q.turbulence == "sst" else {}),
+        q = q.with_(turbulence=turbulence, reynolds=speed * section.chord_m / NU_AIR)
+    phys = q.physics
+    row: dict = {"speed_m_s": speed, "reynolds": phys.reynolds, "turbulence": phys.turbulence, "quality": quality,
+                 "grid": grid, **({"sst_walls": phys.sst_walls} if phys.turbulence == "sst" else {}),
                  "omega": omega, "angular_frequency_rad_s": omega * speed / section.chord_m, "cases": {}}
     for dof in ("heave", "pitch"):
         case = ForcedCase.thesis(dof, omega)
@@ -144,8 +136,9 @@ def main(argv=None) -> int:
                          "whose SST forces jitter as the deck's faces change class (docs/aero.md)")
     ap.add_argument("--threads", type=int, default=None,
                     help="CPU threads of each case (default: 2 on grids of 20 000 cells or more, else 1)")
-    ap.add_argument("--sst-walls", default=Quality.sst_walls, choices=SST_WALLS,
-                    help=f"with SST, the deck's walls (Quality.sst_walls; default {Quality.sst_walls!r}, the presets')")
+    walls = Physics(reynolds=1.0).sst_walls   # the presets' wall treatment
+    ap.add_argument("--sst-walls", default=walls, choices=SST_WALLS,
+                    help=f"with SST, the deck's walls (Physics.sst_walls; default {walls!r}, the presets')")
     ap.add_argument("--out", default="out/reynolds_study.json")
     args = ap.parse_args(argv)
     if len(args.speeds) < 2 or any(not 1.0 <= v <= 200.0 for v in args.speeds):

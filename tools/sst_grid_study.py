@@ -21,7 +21,6 @@ import json
 import math
 import sys
 import time
-from dataclasses import replace
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
@@ -29,8 +28,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from reynolds_study import NU_AIR, run_speed, start_study  # noqa: E402
 
-from bridge.aero.forced_motion import QUALITY, StaticCase, checkpoint_path, preset, run_case  # noqa: E402
-from bridge.aero.stage import _unit_polygons  # noqa: E402
+from bridge.aero.forced_motion import StaticCase, checkpoint_path, run_case  # noqa: E402
+from bridge.aero.presets import QUALITY, preset, section_polygons  # noqa: E402
 from bridge.aero.static import static_coefficients  # noqa: E402
 from bridge.cfd.sections import great_belt_section  # noqa: E402
 
@@ -43,10 +42,10 @@ def _say(message: str) -> None:
 
 def run_resolution(cells: int, args, runs: Path) -> dict:
     section = great_belt_section()
-    polys = _unit_polygons(section)
-    q = replace(preset(args.quality, "overset"), turbulence="sst", reynolds=args.speed * section.chord_m / NU_AIR,
+    polys = section_polygons(section)
+    q = preset(args.quality, "overset").with_(turbulence="sst", reynolds=args.speed * section.chord_m / NU_AIR,
                 cells_per_chord=cells, cfl=args.cfl)
-    row: dict = {"cells_per_chord": cells, "cfl": args.cfl, "reynolds": q.reynolds, "static": {}}
+    row: dict = {"cells_per_chord": cells, "cfl": args.cfl, "reynolds": q.physics.reynolds, "static": {}}
     grid_angle = max(abs(a) for a in args.angles)
     for angle in args.angles:
         case = StaticCase(angle, grid_angle)

@@ -20,7 +20,6 @@ import json
 import math
 import sys
 import time
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -28,20 +27,16 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from bridge.aero.forced_motion import (  # noqa: E402
-    GRIDS,
-    QUALITY,
-    SST_WALLS,
     THESIS_HEAVE_RATE,
     THESIS_PITCH_RATE,
     ForcedCase,
     checkpoint_path,
-    preset,
     run_case,
     whole_periods,
 )
 from bridge.aero.frequency_response import forced_motion_response  # noqa: E402
 from bridge.aero.options import AeroOptions  # noqa: E402
-from bridge.aero.stage import _unit_polygon  # noqa: E402
+from bridge.aero.presets import GRIDS, QUALITY, SST_WALLS, preset, section_polygons  # noqa: E402
 from bridge.cfd.sections import FlatPlate  # noqa: E402
 from bridge.errors import InputError  # noqa: E402
 from bridge.flutter.aerodynamics import Theodorsen  # noqa: E402
@@ -57,42 +52,43 @@ GRID_FIELDS = ("cells_per_chord", "dy_over_dx", "background_coarsening")
 def plate_quality(quality: str, grid: str, turbulence: str = "laminar", reynolds: float | None = None,
                   grid_overrides: dict | None = None, sst_walls: str = "function"):
     """The preset on ``grid``; with ``turbulence = "sst"`` the k-omega SST model at ``reynolds`` with the plate's
-    walls treated by ``sst_walls`` (Quality.sst_walls); ``grid_overrides`` replaces fields of GRID_FIELDS
+    walls treated by ``sst_walls`` (Physics.sst_walls); ``grid_overrides`` replaces fields of GRID_FIELDS
     (checked by Quality: InputError names the field)."""
     q = preset(quality, grid)
     if turbulence != "laminar":
-        q = replace(q, turbulence=turbulence, reynolds=float(reynolds), sst_walls=sst_walls)
+        q = q.with_(turbulence=turbulence, reynolds=float(reynolds), sst_walls=sst_walls)
     elif reynolds is not None:
-        q = replace(q, reynolds=float(reynolds))
+        q = q.with_(reynolds=float(reynolds))
     overrides = {k: v for k, v in (grid_overrides or {}).items() if v is not None}
     unknown = sorted(set(overrides) - set(GRID_FIELDS))
     if unknown:
         raise ValueError(f"grid_overrides: {unknown} not among {GRID_FIELDS}")
-    return replace(q, **overrides)
+    return q.with_(**overrides)
 
 
 def resolution_warnings(q, thickness: float) -> list[str]:
-    """What a laminar run of the plate on ``q``'s grid will not resolve at ``q.reynolds`` (none with SST, whose
+    """What a laminar run of the plate on ``q``'s grid will not resolve at ``q.physics.reynolds`` (none with SST, whose
     wall function stands in for the boundary layer).  Two limits, both seen in runs of docs/aero.md:
     - the boundary layer: Blasius's thickness at the trailing edge, 4.91 B / sqrt(Re), should span at least 4
       cells (at Re 1e5 on 40 cells per chord it spans 2.5 and H1* came out 38 % off);
     - the square trailing edge sheds once Re t/B reaches about 100 (the body-fitted OpenFOAM plate shed at
       Re t/B = 200, not at 20), and following it takes cells of a quarter of the thickness along x (at Re
       10 000 H1* was 11 % off on 80 cells per chord and 5 % on 200, where dx = t/4)."""
-    if q.turbulence != "laminar":
+    if q.physics.turbulence != "laminar":
         return []
     out = []
-    dx = 1.0 / q.cells_per_chord
-    delta = 4.91 / math.sqrt(q.reynolds)
-    across = delta / (q.dy_over_dx * dx)      # cells across the boundary layer at the trailing edge
+    dx = 1.0 / q.grid.cells_per_chord
+    delta = 4.91 / math.sqrt(q.physics.reynolds)
+    across = delta / (q.grid.dy_over_dx * dx)      # cells across the boundary layer at the trailing edge
     if across < 4.0:
-        out.append(f"the boundary layer (Blasius: {delta:.3g} B at the trailing edge, Re {q.reynolds:g}) spans "
+        out.append(f"the boundary layer (Blasius: {delta:.3g} B at the trailing edge, Re {q.physics.reynolds:g}) spans "
                    f"{across:.1f} cells, fewer than 4: the forces are not resolved; refine "
                    "(--cells-per-chord, --dy-over-dx) or lower --reynolds")
-    if q.reynolds * thickness >= 100.0 and thickness / dx < 4.0:
-        out.append(f"at Re t/B = {q.reynolds * thickness:g} the square trailing edge sheds, which takes cells of a "
+    if q.physics.reynolds * thickness >= 100.0 and thickness / dx < 4.0:
+        out.append(f"at Re t/B = {q.physics.reynolds * thickness:g} the square trailing edge sheds, which takes cells "
+                   "of a "
                    f"quarter of its thickness along x ({thickness / 4:.3g} B, {math.ceil(4 / thickness)} cells per "
-                   f"chord); this grid has {q.cells_per_chord}")
+                   f"chord); this grid has {q.grid.cells_per_chord}")
     return out
 
 
@@ -102,7 +98,7 @@ def plate_derivatives(reduced_velocity: float, quality: str, thickness: float, s
                       grid_overrides: dict | None = None, dofs=("heave", "pitch"), sst_walls: str = "function") -> dict:
     """One heave and one pitch run (``dofs``: one of them alone gives only its four derivatives, the
     others None) at ``reduced_velocity``; a row of the derivatives beside Theodorsen's."""
-    poly = _unit_polygon(FlatPlate(1.0, thickness))
+    poly = section_polygons(FlatPlate(1.0, thickness))[0]
     q = plate_quality(quality, grid, turbulence, reynolds, grid_overrides, sst_walls)
     K = 2 * np.pi / reduced_velocity
     h, wall = {}, 0.0
@@ -123,8 +119,8 @@ def plate_derivatives(reduced_velocity: float, quality: str, thickness: float, s
     cfd = derivatives_from_frf(np.array([K]), frf)
     ref = derivatives_from_frf(np.array([K]), Theodorsen().frf(np.array([K]), 1.0))
     row = {"reduced_velocity": reduced_velocity, "K": K, "quality": quality, "grid": grid, "thickness": thickness,
-           "turbulence": q.turbulence, "reynolds": q.reynolds,
-           **{k: getattr(q, k) for k in GRID_FIELDS},
+           "turbulence": q.physics.turbulence, "reynolds": q.physics.reynolds,
+           **{k: getattr(q.grid, k) for k in GRID_FIELDS},
            "cells": cells, "grids": rec.meta["grids"], "wall_s": wall, "periods_fitted": periods,
            "frf": {k: [v.real, v.imag] for k, v in h.items()}}
     for n in NAMES:
@@ -141,7 +137,7 @@ def multi_frequency_check(reduced_velocities, quality: str, thickness: float, si
     """One heave and one pitch run at all the reduced velocities at once (ForcedCase.multi_frequency, each
     sine at the single run's amplitude) against the single runs ``singles``: rows of
     (U/(fB), name, multi, single, |multi - single| / |single|)."""
-    poly = _unit_polygon(FlatPlate(1.0, thickness))
+    poly = section_polygons(FlatPlate(1.0, thickness))[0]
     q = plate_quality(quality, grid, turbulence, reynolds, grid_overrides, sst_walls)
     Ks = tuple(sorted(2 * np.pi / np.asarray(reduced_velocities)))
     rows = []
@@ -176,7 +172,7 @@ def main(argv=None) -> int:
     ap.add_argument("--reynolds", type=float, default=None,
                     help="Reynolds number on the chord (default: the preset's; needed with --turbulence sst)")
     ap.add_argument("--sst-walls", default="function", choices=SST_WALLS,
-                    help="with SST, the plate's walls (Quality.sst_walls): Spalding's wall function with the model's "
+                    help="with SST, the plate's walls (Physics.sst_walls): Spalding's wall function with the model's "
                          "k production (default: the documented plate runs'), blended with the no-slip profile where "
                          "the layer is not turbulent, with the log layer's own k production (the layer turbulent from "
                          "the front; the aero stage's default), or resolved")

@@ -18,7 +18,6 @@ section of bridge/cfd/sections.py on a preset, for the report.  Prints a table; 
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import json
 import math
 import sys
@@ -29,8 +28,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from bridge.aero.forced_motion import QUALITY, QUICK_UNTIL_2026_12_02, StaticCase, run_case  # noqa: E402
-from bridge.aero.stage import _unit_polygons  # noqa: E402
+from bridge.aero.forced_motion import StaticCase, run_case  # noqa: E402
+from bridge.aero.presets import QUALITY, SHORT_DOMAIN_40, section_polygons  # noqa: E402
 from bridge.aero.static import static_coefficients  # noqa: E402
 from bridge.cfd import Polygon, circle  # noqa: E402
 from bridge.cfd.sections import FlatPlate, Rectangle, great_belt_section  # noqa: E402
@@ -50,7 +49,7 @@ def cylinder(cells: int, duration: float) -> dict:
     # turned by a fraction of a facet and moved off the grid's mirror line by 0.3 cells: a start that is not
     # mirror-symmetric, so that shedding sets in within a few tens of D/U instead of growing from round-off
     poly = Polygon(poly.vertices @ np.array([[c, s], [-s, c]]) + np.array([0.0, 0.3 / cells]))
-    q = dataclasses.replace(QUALITY["standard"], name=f"cylinder D/{cells}", cells_per_chord=cells, dy_over_dx=1.0,
+    q = QUALITY["standard"].with_(name=f"cylinder D/{cells}", cells_per_chord=cells, dy_over_dx=1.0,
                             upstream=8.0, downstream=20.0, half_height=10.0, core_half_height=1.0, reynolds=100.0,
                             static_duration=duration)
     rec = run_case(poly, StaticCase(0.0), q, progress=_say, label=f"cylinder D/{cells}")
@@ -82,7 +81,7 @@ def main(argv=None) -> int:
                     help="rectangle: B/D = 5 (BARC's); great_belt: the streamlined box of bridge/cfd/sections.py")
     ap.add_argument("--quality", default="quick", choices=sorted(QUALITY))
     ap.add_argument("--plate-domain", default="old-quick", choices=("old-quick", "preset"),
-                    help="plate: the 2 / 10 / 2 chord domain of the earlier runs in docs/aero.md, or --quality's")
+                    help="plate: the short 2 / 10 / 2 chord domain (presets.SHORT_DOMAIN_40), or --quality's")
     ap.add_argument("--upstream", type=float, default=None, help="plate: chords upstream (default: the domain's)")
     ap.add_argument("--half-height", type=float, default=None, help="plate: chords to each side (default: domain's)")
     ap.add_argument("--reynolds", type=float, default=None, help="plate: Reynolds number (default: the preset's)")
@@ -99,24 +98,24 @@ def main(argv=None) -> int:
                   f"{WILLIAMSON_ST_RE100:.4f}), C_L rms = {r['lift_rms']:.3f}, averaged over t = "
                   f"{r['window'][0]:.0f}-{r['window'][1]:.0f}, {r['wall_s']:.0f} s", flush=True)
     elif args.case == "plate":
-        poly = _unit_polygons(FlatPlate(1.0, args.thickness))
+        poly = section_polygons(FlatPlate(1.0, args.thickness))
         for n in args.cells or [24, 40]:
-            # the domain and run length of the earlier runs in docs/aero.md, or the preset's (its grid, n cells)
-            base = QUICK_UNTIL_2026_12_02 if args.plate_domain == "old-quick" else QUALITY[args.quality]
+            # the short domain and its run length (SHORT_DOMAIN_40), or the preset's (its grid, n cells)
+            base = SHORT_DOMAIN_40 if args.plate_domain == "old-quick" else QUALITY[args.quality]
             given = {"upstream": args.upstream, "half_height": args.half_height, "reynolds": args.reynolds}
-            q = dataclasses.replace(base, name=f"plate {n}/chord", cells_per_chord=n,
+            q = base.with_(name=f"plate {n}/chord", cells_per_chord=n,
                                     **{k: v for k, v in given.items() if v is not None})
             r = sweep(poly, args.thickness, q)
             rows.append({"case": "plate", "cells_per_chord": n, **r})
             (_, dcl), (_, dcm) = r["fits"]["lift"], r["fits"]["moment"]
             print(f"plate t/B = {args.thickness:g}, {n} cells per chord ({r['cells'][0]} x {r['cells'][1]}), "
-                  f"Re {q.reynolds:g}: dC_L/dalpha = {dcl:.3f} (2 pi = 6.283, ratio {dcl / (2 * np.pi):.3f}), "
+                  f"Re {q.physics.reynolds:g}: dC_L/dalpha = {dcl:.3f} (2 pi = 6.283, ratio {dcl / (2 * np.pi):.3f}), "
                   f"dC_M/dalpha / dC_L/dalpha = {dcm / dcl:.3f} (0.25), C_D(0) = {r['drag'][1]:.4f}, "
                   f"{r['wall_s']:.0f} s", flush=True)
     else:
         section = Rectangle(5.0, 1.0) if args.section == "rectangle" else great_belt_section()
         q = QUALITY[args.quality]
-        r = sweep(_unit_polygons(section), section.depth_m / section.chord_m, q)
+        r = sweep(section_polygons(section), section.depth_m / section.chord_m, q)
         rows.append({"case": args.section, "quality": args.quality, **r})
         print(json.dumps(r["fits"]), "St", r["strouhal_on_depth"], f"{r['wall_s']:.0f} s", flush=True)
     print(f"total {time.perf_counter() - t0:.0f} s")

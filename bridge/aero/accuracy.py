@@ -4,7 +4,7 @@ A flutter speed from the CFD without its grid error is a number nobody can use. 
 :data:`bridge.aero.forced_motion.QUALITY` were studied on one deck and one flow model - the Great Belt box
 (:func:`bridge.cfd.sections.great_belt_section`, no railings) on the overset pair in URANS with the k-omega
 SST model and the equilibrium wall at the deck's Reynolds number - and what the study found is recorded
-here as data, beside how it was measured (docs/aero.md, "Derivatives and flutter speed", reproduces each
+here as data, beside how it was measured (docs/aero.md, "Grid study", reproduces each
 figure).  A run of that deck and flow model gets its preset's record (:func:`grid_accuracy`); any other
 deck, flow model or preset is told plainly that no grid study covers it.
 

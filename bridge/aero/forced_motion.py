@@ -28,7 +28,6 @@ import math
 import os
 import re
 import signal
-import tempfile
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
@@ -36,106 +35,16 @@ from pathlib import Path
 
 import numpy as np
 
+from bridge.aero.presets import Quality, build_flow
 from bridge.errors import DivergedError, InputError, check_range
+from bridge.stages import CFD_KERNELS, code_digest
 
-__all__ = ["Quality", "QUALITY", "ForcedCase", "StaticCase", "ForceRecord", "run_case", "case_key",
-           "checkpoint_path", "whole_periods", "run_cases", "default_workers", "preset", "GRIDS", "TURBULENCE",
-           "SST_WALLS", "QUICK_UNTIL_2026_12_02",
-           "THESIS_HEAVE_RATE", "THESIS_PITCH_RATE"]
+__all__ = ["ForcedCase", "StaticCase", "ForceRecord", "run_case", "case_key", "checkpoint_path", "whole_periods",
+           "fit_window",
+           "run_cases", "default_workers", "THESIS_HEAVE_RATE", "THESIS_PITCH_RATE"]
 
-TURBULENCE = ("laminar", "sst")
-SST_WALLS = ("equilibrium", "function", "blended", "resolved")
 THESIS_HEAVE_RATE = 0.4 / 50.0            # udot_0 / V (thesis 5.3)
 THESIS_PITCH_RATE = 0.028 * 31.0 / 50.0   # thetadot_0 B / V (thesis 5.3)
-
-
-@dataclass(frozen=True)
-class Quality:
-    """Grid and time step of a preset, in chords.  x is uniform (the direct Poisson solver); y is uniform
-    with spacing ``dy_over_dx`` dx in a core band around the deck and stretches by ``stretch`` beyond."""
-
-    name: str
-    cells_per_chord: int
-    dy_over_dx: float
-    upstream: float
-    downstream: float
-    half_height: float
-    core_half_height: float
-    reynolds: float
-    cfl: float = 0.5
-    stretch: float = 1.08
-    periods: int = 5
-    discard_periods: int = 2
-    static_duration: float = 30.0   # a section held still: run length in convective times B / V
-    settle_time: float = 16.0       # forced motion: at least this many B / V dropped before the fit
-    # overset grids (bridge.cfd.overset): the section in a body grid of this preset's spacing (dx, and
-    # dy = dy_over_dx dx) reaching ``body_margin`` chords (at least 6 background cells) beyond it, over a
-    # background whose cells are ``background_coarsening`` times larger; False: one grid, the section an
-    # immersed body moving on it
-    overset: bool = False
-    background_coarsening: int = 2
-    body_margin: float = 0.35
-    # "laminar", or "sst": the k-omega SST model (bridge.cfd.turbulence, the 2003 variant) with Spalding's
-    # wall function on the section (either grid), at the deck's Reynolds number
-    turbulence: str = "laminar"
-    # with "sst", the section's walls (bridge.cfd.KOmegaSST's body_walls): "equilibrium" (Spalding's wall
-    # function with the log layer's own k production, so the layer is turbulent from the front: the presets'
-    # since 2026-12-04, docs/aero.md), "function" (the same wall function with the model's production, the
-    # presets' before), "blended" (the wall function where the layer next to the wall is turbulent, the
-    # no-slip linear profile where it is not; under study) or "resolved" (a diagnostic)
-    sst_walls: str = "equilibrium"
-
-    def __post_init__(self):
-        check_range("aero.cells_per_chord", self.cells_per_chord, 8, 2000)
-        check_range("aero.dy_over_dx", self.dy_over_dx, 0.05, 1.0)
-        if self.turbulence not in TURBULENCE:
-            raise InputError("aero.turbulence", self.turbulence, f"one of {', '.join(TURBULENCE)}")
-        if self.sst_walls not in SST_WALLS:
-            raise InputError("aero.sst_walls", self.sst_walls, f"one of {', '.join(SST_WALLS)}")
-        check_range("aero.reynolds", self.reynolds, 1.0, 1e6 if self.turbulence == "laminar" else 1e10)
-        check_range("aero.static_duration", self.static_duration, 1.0, 1e4)
-        check_range("aero.settle_time", self.settle_time, 0.0, 1e4)
-        check_range("aero.background_coarsening", self.background_coarsening, 1, 16)
-        check_range("aero.body_margin", self.body_margin, 0.05, 5.0)
-        if not (0 < self.discard_periods < self.periods):
-            raise InputError("aero.discard_periods", self.discard_periods,
-                             f"must be >= 1 and below periods ({self.periods})")
-
-
-# Presets.  The laminar solver cannot run the deck's Reynolds number (1e8): the presets use a low one
-# and say so; the k-omega SST model of the turbulence issue will lift that limit.
-QUALITY = {
-    "tiny": Quality("tiny", 12, 0.5, 1.0, 2.0, 1.0, 0.25, 500.0, periods=3, discard_periods=1, static_duration=6.0,
-                    settle_time=2.0),
-    # quick, standard and fine share one domain and halve the cell from one to the next: a grid sequence.
-    # The wake must be long: with 3 chords of it the lift of a pitching plate came out 25 % high, with 10
-    # chords 13 %, with 20 chords within 0.3 % of Theodorsen (docs/aero.md).  quick: a first look in minutes
-    # (the Great Belt's SST chain in about 4 on this machine), not a converged answer - its distance from
-    # the finer presets is in docs/aero.md (grid study); one period dropped instead of two (the fits of
-    # periods 2-3 and 3-4 of the deck's runs agreed within 1.3 %) and statics of 20 B/V (settled to 0.5 %
-    # after 10 B/V).
-    "quick": Quality("quick", 16, 0.25, 3.0, 20.0, 3.0, 0.2, 1000.0, periods=3, discard_periods=1,
-                     static_duration=20.0),
-    "standard": Quality("standard", 40, 0.25, 3.0, 20.0, 3.0, 0.2, 1000.0, periods=4, discard_periods=2),
-    "fine": Quality("fine", 80, 0.25, 3.0, 20.0, 3.0, 0.2, 2000.0, periods=5, discard_periods=2,
-                    static_duration=40.0),
-}
-
-
-# The quick preset as it was until 2026-12-02 (40 cells per chord, 2 / 10 / 2 chords): the grid of the runs
-# documented before then (docs/aero.md), kept for the tools and tests that repeat them; not a user preset.
-QUICK_UNTIL_2026_12_02 = Quality("quick", 40, 0.25, 2.0, 10.0, 2.0, 0.2, 1000.0, periods=4, discard_periods=2)
-
-GRIDS = ("single", "overset")
-
-
-def preset(quality: str, grid: str = "single") -> Quality:
-    """The quality preset ``quality`` on one grid ("single") or on the overset pair ("overset")."""
-    from dataclasses import replace
-
-    if grid not in GRIDS:
-        raise InputError("aero.grid", grid, f"one of {', '.join(GRIDS)}")
-    return replace(QUALITY[quality], overset=grid == "overset")
 
 
 @dataclass(frozen=True)
@@ -174,7 +83,7 @@ class ForcedCase:
         """A sum of sines at the reduced frequencies ``Ks`` (whole multiples of the lowest) in one run.
 
         Each sine gets the velocity amplitude ``rate`` of a single run: the moving immersed boundary's error
-        depends on how many cells the body travels (docs/aero.md, amplitude study), so a sine of a smaller
+        depends on how many cells the body travels, so a sine of a smaller
         amplitude would not measure the same thing as its single run.  The displacement then peaks at no more
         than sum(1/m) times the lowest sine's (2.08 for four harmonics), still a small motion; Schroeder's
         phases (phi_m = -pi m (m - 1) / M for harmonic m of M, IEEE Trans. Inf. Theory 16, 1970) keep the
@@ -217,24 +126,24 @@ class ForcedCase:
                                 lambda t: (0.0, 0.0, -self.rate(t)))
 
     def discarded_periods(self, q: Quality) -> int:
-        """Periods of the fundamental dropped before the fit: ``q.discard_periods``, or more if they last less
-        than ``q.settle_time``.  The start-up decays in convective time (the shed vorticity of the first
+        """Periods of the fundamental dropped before the fit: ``q.run.discard_periods``, or more if they last less
+        than ``q.run.settle_time``.  The start-up decays in convective time (the shed vorticity of the first
         periods has to travel away), not in periods, so at high K two periods are a short wait; it also
         gives single runs the wait of a multi-frequency run (two periods of its lowest frequency).  A margin,
-        not a measured need: on a short grid the periods after 8 B/V already agreed to 0.1 % (docs/aero.md)."""
+        not a measured need: on a short grid the periods after 8 B/V already agreed to 0.1 %."""
         T = 2 * math.pi / self.fundamental
-        return max(q.discard_periods, math.ceil(q.settle_time / T - 1e-9))
+        return max(q.run.discard_periods, math.ceil(q.run.settle_time / T - 1e-9))
 
     def end_time(self, q: Quality) -> float:
-        """The dropped periods and then ``q.periods - q.discard_periods`` periods to fit."""
-        return (self.discarded_periods(q) + q.periods - q.discard_periods) * 2 * math.pi / self.fundamental
+        """The dropped periods and then ``q.run.periods - q.run.discard_periods`` periods to fit."""
+        return (self.discarded_periods(q) + q.run.periods - q.run.discard_periods) * 2 * math.pi / self.fundamental
 
     def excursion(self, radius: float) -> float:
         """Largest vertical travel of a point of the body (``radius``: its farthest point from the axis)."""
         return sum(abs(a) for a in self.amplitudes) * (1.0 if self.dof == "heave" else radius)
 
     def progress(self, t: float, q: Quality) -> str:
-        total = self.discarded_periods(q) + q.periods - q.discard_periods
+        total = self.discarded_periods(q) + q.run.periods - q.run.discard_periods
         return f"{t * self.fundamental / (2 * math.pi):.1f} of {total} periods"
 
 
@@ -262,7 +171,7 @@ class StaticCase:
         return Stationary(0.0, 0.0, -math.radians(self.angle_deg))
 
     def end_time(self, q: Quality) -> float:
-        return q.static_duration
+        return q.run.static_duration
 
     def excursion(self, radius: float) -> float:
         return math.sin(math.radians(self.grid_angle_deg)) * radius
@@ -289,25 +198,6 @@ class ForceRecord:
     snapshot: dict | None = None    # the flow at the end of the run (bridge.aero.snapshots.flow_snapshot)
 
 
-def _grid(q: Quality, reach: float, h: float | None = None, upstream: float | None = None,
-          downstream: float | None = None, side_cells: int = 0):
-    """The preset's grid; the uniform core band holds the body wherever the motion takes it (``reach``:
-    largest |y| of the body over the motion) with 4 cells to spare.  ``h`` (default the preset's dx),
-    ``upstream``, ``downstream`` override the preset's; ``side_cells``: cells kept between the core and
-    the sides at least (the sides move out if needed)."""
-    from bridge.cfd import CartesianGrid, stretched_faces
-
-    h = 1.0 / q.cells_per_chord if h is None else h
-    up = q.upstream if upstream is None else upstream
-    down = q.downstream if downstream is None else downstream
-    nx = int(round((up + down) / h))
-    x = np.linspace(-up, down, nx + 1)
-    core = max(q.core_half_height, reach + 4 * h)
-    half = max(q.half_height, core + side_cells * h)
-    y = stretched_faces(-half, half, (-core, core), q.dy_over_dx * h, q.stretch)
-    return CartesianGrid(x, y)
-
-
 def _polygons(shape) -> list:
     """A Polygon or a list of them (a deck with railings) as a list."""
     return list(shape) if isinstance(shape, (list, tuple)) else [shape]
@@ -316,12 +206,9 @@ def _polygons(shape) -> list:
 def case_key(shape, case: ForcedCase, q: Quality) -> str:
     """What a checkpoint must match to be resumed: the geometry, the case, the preset and the source of
     the solver (a changed CFD code never resumes an old run)."""
-    from bridge.cache import _code_digest
-    from bridge.stages import CFD_KERNELS
-
     blob = json.dumps({"verts": [np.round(p.vertices, 12).tolist() for p in _polygons(shape)], "case": asdict(case),
-                       "quality": asdict(q), "code": _code_digest(("bridge.cfd", *CFD_KERNELS,
-                                                                    "bridge.aero.forced_motion"))}, sort_keys=True)
+                       "quality": asdict(q), "code": code_digest(("bridge.cfd", *CFD_KERNELS, "bridge.aero.presets",
+                                                                   "bridge.aero.forced_motion"))}, sort_keys=True)
     return hashlib.sha256(blob.encode()).hexdigest()
 
 
@@ -330,51 +217,13 @@ def checkpoint_path(runs: Path | None, shape, case, q: Quality) -> Path | None:
     return None if runs is None else Path(runs) / f"{case_key(shape, case, q)[:24]}.h5"
 
 
-def _save_checkpoint(path: Path, key: str, flow, rec: dict) -> None:
-    import h5py
-
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    os.close(fd)
-    try:
-        with h5py.File(tmp, "w") as h5:
-            h5.attrs["case_key"] = key
-            h5.attrs["t"] = flow.t
-            h5.attrs["n_steps"] = flow.n_steps
-            for name, values in flow.checkpoint_arrays().items():
-                h5.create_dataset(f"state/{name}", data=values)
-            for name, values in rec.items():
-                h5.create_dataset(f"record/{name}", data=np.asarray(values))
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
-def _load_checkpoint(path: Path, key: str, flow) -> dict | None:
-    import h5py
-
-    if not path.is_file():
-        return None
-    try:
-        with h5py.File(path, "r") as h5:
-            if h5.attrs.get("case_key") != key:
-                return None
-            arrays = {}
-            h5["state"].visititems(lambda name, obj: arrays.__setitem__(name, obj[()])
-                                   if isinstance(obj, h5py.Dataset) else None)
-            flow.restore_arrays(arrays, float(h5.attrs["t"]), int(h5.attrs["n_steps"]))
-            return {name: list(h5[f"record/{name}"][()]) for name in h5["record"]}
-    except (OSError, KeyError, ValueError):   # unreadable or of another grid: start afresh
-        return None
-
-
 def run_case(shape, case: ForcedCase | StaticCase, quality: Quality, checkpoint: Path | None = None,
              checkpoint_every: int = 2000, threads: int | None = None,
              progress: Callable[[str], None] | None = None, label: str = "",
              observe: Callable[[object], None] | None = None) -> ForceRecord:
     """Run one case - forced motion for :meth:`ForcedCase.end_time` (the caller drops the first
     :meth:`ForcedCase.discarded_periods`, :func:`whole_periods`), or a section held still for
-    ``quality.static_duration`` - and return the whole force record.  ``shape``: the section's polygon,
+    ``quality.run.static_duration`` - and return the whole force record.  ``shape``: the section's polygon,
     or a list of polygons moving together (a box with railings); the loads are their sum.  Resumes from
     ``checkpoint`` if it holds this case (:func:`case_key`); progress lines about every 10 % of the run.
     ``threads``: CPU threads of the step (default 2, but 1 below 20 000 cells, where waiting for the second thread
@@ -385,15 +234,10 @@ def run_case(shape, case: ForcedCase | StaticCase, quality: Quality, checkpoint:
     the flow is a ``bridge.cfd.OversetPair``, whose ``body`` simulation moves with the section."""
     from bridge.cfd import FlowDiverged
 
-    q = quality
     polys = _polygons(shape)
+    flow = build_flow(quality, polys, case, threads)
     try:
-        flow = _overset_flow(q, polys, case, threads) if q.overset else _SingleGridFlow(q, polys, case, threads)
-    except ValueError as err:   # the section and the preset's grid do not fit together
-        raise InputError("aero.quality", q.name, f"its {'overset' if q.overset else 'single'} grid cannot hold "
-                         f"this section and motion ({err})") from None
-    try:
-        return _march(flow, polys, case, q, checkpoint, checkpoint_every, progress, label, observe)
+        return _march(flow, polys, case, quality, checkpoint, checkpoint_every, progress, label, observe)
     except FlowDiverged as err:
         raise DivergedError(f"the CFD of {label or case}", str(err)) from None
 
@@ -478,7 +322,7 @@ def run_cases(shape, jobs, quality: Quality, checkpoint_every: int = 2000,
 
     With ``workers`` > 1 (default :func:`default_workers`) the cases run side by side in that many
     processes, each on one core: on this project's 2-core machine two cases at once finish sooner than the
-    same cases one after the other on two threads each (docs/performance.md, "The aero stage").  Their
+    same cases one after the other on two threads each (docs/performance.md, "The whole chain").  Their
     progress lines reach ``progress`` from here.  A case that fails stops the others (each keeps its last
     checkpoint) and its error is raised here; so is Ctrl-C, which the running cases receive too."""
     import multiprocessing
@@ -527,53 +371,60 @@ def run_cases(shape, jobs, quality: Quality, checkpoint_every: int = 2000,
     return [f.result() for f in futures]
 
 
-def _march(flow, polys, case, q, checkpoint, checkpoint_every, progress, label, observe=None) -> ForceRecord:
-    """Run ``flow`` to the case's end time, with checkpoints and progress (run_case)."""
-    from bridge.cfd import FlowDiverged, NaNMonitor, ProgressNote
+class _CaseRecord:
+    """Monitor: the loads of every step in the flutter convention (lift up, drag downwind, moment nose-up =
+    -M_z) and the prescribed displacement; stops the run on non-finite loads."""
 
-    key = case_key(polys, case, q)
-    names = ("t", "lift", "drag", "moment", "motion")
-    rec = {n: [] for n in names}
+    NAMES = ("t", "lift", "drag", "moment", "motion")
+
+    def __init__(self, case, columns: dict | None = None):
+        self.case = case
+        self.columns = {n: list((columns or {}).get(n, [])) for n in self.NAMES}
+
+    def __call__(self, flow) -> None:
+        from bridge.cfd import FlowDiverged
+
+        fx, fy, mz = flow.total_force   # all parts about the same reference point
+        if not np.all(np.isfinite((fx, fy, mz))):
+            raise FlowDiverged(f"non-finite loads at t = {flow.t:.6g} (step {flow.n_steps})")
+        c = self.columns
+        c["t"].append(flow.t)
+        c["lift"].append(fy)
+        c["drag"].append(fx)
+        c["moment"].append(-mz)
+        c["motion"].append(self.case.displacement(flow.t))
+
+
+def _march(flow, polys, case, q: Quality, checkpoint, checkpoint_every, progress, label, observe=None) -> ForceRecord:
+    """Run ``flow`` to the case's end time with the loop of bridge.cfd (bridge.cfd.flow.run): the record of
+    its loads, checkpoints, a check for non-finite fields and progress lines as monitors (run_case)."""
+    from bridge.cfd import Checkpoint, NaNMonitor, ProgressNote, run
+
+    record = _CaseRecord(case)
+    saver = None
     resumed = 0
     if checkpoint is not None:
-        checkpoint = Path(checkpoint)
-        checkpoint.parent.mkdir(parents=True, exist_ok=True)
-        got = _load_checkpoint(checkpoint, key, flow)
+        saver = Checkpoint(checkpoint, case_key(polys, case, q), checkpoint_every, lambda: record.columns)
+        got = saver.resume(flow)
         if got is not None:
-            rec = {n: list(got.get(n, [])) for n in names}
+            record = _CaseRecord(case, got)
             resumed = flow.n_steps
             if progress:
                 progress(f"{label}: resuming at t = {flow.t:.2f} (step {resumed}) from {checkpoint}")
     t_end = case.end_time(q)
-    nans = [NaNMonitor(every=200) for _ in flow.simulations]
+    monitors = [record, NaNMonitor(every=200)]
+    if observe is not None:
+        monitors.append(observe)
+    if saver is not None:
+        monitors.append(saver)
+    if progress:
+        monitors.append(ProgressNote(label, t_end, sink=progress,
+                                     detail=lambda f: f"{case.progress(f.t, q)}, {f.describe()}"))
     t0 = time.perf_counter()
-    note = None if not progress else ProgressNote(label, t_end, sink=progress,
-                                                  detail=lambda f: f"{case.progress(f.t, q)}, {f.describe()}")
-    while flow.t < t_end - 1e-12 * t_end:
-        dt = flow.stable_dt()
-        if not (np.isfinite(dt) and dt > 0.0):   # a non-finite velocity makes the limit infinite or NaN
-            raise FlowDiverged(f"the time step became {dt!r} at t = {flow.t:.6g} (step {flow.n_steps}): the flow "
-                               "is no longer finite")
-        flow.step(dt)
-        fx, fy, mz = flow.last_force   # all parts about the same reference point
-        if not np.all(np.isfinite((fx, fy, mz))):
-            raise FlowDiverged(f"non-finite loads at t = {flow.t:.6g} (step {flow.n_steps})")
-        rec["t"].append(flow.t)
-        rec["lift"].append(fy)
-        rec["drag"].append(fx)
-        rec["moment"].append(-mz)
-        rec["motion"].append(case.displacement(flow.t))
-        for nan, sim in zip(nans, flow.simulations, strict=True):
-            nan(sim)
-        if observe is not None:
-            observe(flow)
-        if checkpoint is not None and flow.n_steps % checkpoint_every == 0:
-            _save_checkpoint(checkpoint, key, flow, rec)
-        if note is not None:
-            note(flow)
-    if checkpoint is not None:
-        _save_checkpoint(checkpoint, key, flow, rec)
-    arrays = {n: np.asarray(v, dtype=np.float64) for n, v in rec.items()}
+    run(flow, t_end, monitors)
+    if saver is not None:
+        saver.save(flow)
+    arrays = {n: np.asarray(v, dtype=np.float64) for n, v in record.columns.items()}
     from bridge.aero.snapshots import body_grid_snapshot, flow_snapshot
 
     sim = flow.simulations[0]   # the fixed grid (overset: the background, which holds the body grid's flow
@@ -586,103 +437,20 @@ def _march(flow, polys, case, q, checkpoint, checkpoint_every, progress, label, 
                                                polys, pose)
     return ForceRecord(**arrays, steps=flow.n_steps, wall_s=time.perf_counter() - t0, resumed_from_step=resumed,
                        meta={"nx": grid.nx, "ny": grid.ny, "cells": flow.n_cells, "grids": flow.describe(),
-                             "reynolds": q.reynolds, "quality": q.name, **asdict(case)}, snapshot=snap)
-
-
-class _SingleGridFlow:
-    """One grid, the section an immersed body moving on it.  A flow for :func:`_march`: ``t``,
-    ``n_steps``, ``last_force`` (summed over the parts), ``step``, ``stable_dt``, ``simulations``,
-    ``n_cells``, ``describe``, ``checkpoint_arrays`` / ``restore_arrays``."""
-
-    def __init__(self, q: Quality, polys, case, threads):
-        from bridge.cfd import BoundaryConditions, FlowConfig, Simulation
-
-        radius = max(p.radius for p in polys)
-        grid = _grid(q, max(float(np.abs(p.vertices[:, 1]).max()) for p in polys) + case.excursion(radius))
-        bc = BoundaryConditions(left="inflow", right="outflow", bottom="slip", top="slip")
-        if threads is None:
-            threads = 1 if grid.nx * grid.ny < 20_000 else 2
-        self.sim = Simulation(grid, FlowConfig(nu=1.0 / q.reynolds, advection="vanleer", cfl=q.cfl, threads=threads,
-                                               bc=bc))
-        for p in polys:
-            self.sim.add_body(p, case.motion())
-        self.sim.set_state(u=1.0)
-        self.model = None
-        if q.turbulence == "sst":
-            from bridge.cfd.turbulence import KOmegaSST, freestream_turbulence
-
-            self.model = KOmegaSST(self.sim, *freestream_turbulence(1.0, 1.0 / q.reynolds), body_walls=q.sst_walls)
-        self.simulations = [self.sim]
-        self.n_cells = grid.nx * grid.ny
-
-    t = property(lambda self: self.sim.t)
-    n_steps = property(lambda self: self.sim.n_steps)
-    last_force = property(lambda self: np.sum(self.sim.last_force, axis=0))
-
-    def step(self, dt):
-        out = self.sim.step(dt)
-        if self.model is not None:
-            self.model.advance(dt)
-        return out
-
-    def stable_dt(self):
-        dt = self.sim.stable_dt()
-        return dt if self.model is None else min(dt, self.model.stable_dt())
-
-    def describe(self) -> str:
-        return f"{self.sim.grid.nx} x {self.sim.grid.ny} cells" + ("" if self.model is None else ", SST")
-
-    def checkpoint_arrays(self) -> dict:
-        """The state a resumed run needs to continue bit for bit: the flow's and the SST model's fields
-        (bridge.cfd.state)."""
-        return self.sim.state.arrays()
-
-    def restore_arrays(self, arrays: dict, t: float, n_steps: int) -> None:
-        self.sim.state.assign(arrays)
-        self.sim.t, self.sim.n_steps = t, n_steps
-
-
-def _overset_flow(q: Quality, polys, case, threads):
-    """The section in a body grid that moves with it over a coarser fixed background
-    (``bridge.cfd.OversetPair``, which has the flow interface of :class:`_SingleGridFlow`)."""
-    from bridge.cfd import BoundaryConditions, CartesianGrid, FlowConfig, OversetPair
-
-    h = 1.0 / q.cells_per_chord
-    dy = q.dy_over_dx * h
-    xs = np.concatenate([p.vertices[:, 0] for p in polys])
-    ys = np.concatenate([p.vertices[:, 1] for p in polys])
-    H = q.background_coarsening * h
-    m = max(q.body_margin, 6 * H)   # the hole (4 background cells inside the body grid) covers the body
-    nbx = int(np.ceil((xs.max() - xs.min() + 2 * m) / h))
-    nby = int(np.ceil((ys.max() - ys.min() + 2 * m) / dy))
-    cx, cy = 0.5 * (xs.max() + xs.min()), 0.5 * (ys.max() + ys.min())
-    body = CartesianGrid.uniform(nbx, nby, (cx - 0.5 * nbx * h, cx + 0.5 * nbx * h),
-                                 (cy - 0.5 * nby * dy, cy + 0.5 * nby * dy))
-    # background: the preset's grid with cells background_coarsening times larger, its uniform core holding
-    # the body grid wherever the motion takes it, and the fringe kept 8 cells clear of in-, outflow and sides
-    corners = np.array([[body.x_faces[i], body.y_faces[j]] for i in (0, -1) for j in (0, -1)])
-    reach = float(np.abs(corners[:, 1]).max()) + case.excursion(float(np.hypot(*corners.T).max()))
-    background = _grid(q, reach, h=H, upstream=max(q.upstream, -body.x_faces[0] + 8 * H),
-                       downstream=max(q.downstream, body.x_faces[-1] + 8 * H), side_cells=8)
-    if threads is None:
-        threads = 1 if background.nx * background.ny < 20_000 else 2
-    bc = BoundaryConditions(left="inflow", right="outflow", bottom="slip", top="slip")
-    config = FlowConfig(nu=1.0 / q.reynolds, advection="vanleer", cfl=q.cfl, threads=threads, bc=bc)
-    pair = OversetPair(background, body, config, case.motion(), polygon=polys)
-    pair.set_uniform_flow(1.0)
-    if q.turbulence == "sst":
-        from bridge.cfd.turbulence import OversetSST, freestream_turbulence
-
-        OversetSST(pair, *freestream_turbulence(1.0, 1.0 / q.reynolds), body_walls=q.sst_walls)
-    return pair
+                             "reynolds": q.physics.reynolds, "quality": q.name, **asdict(case)}, snapshot=snap)
 
 
 def whole_periods(record: ForceRecord, case: ForcedCase, q: Quality) -> np.ndarray:
-    """Boolean mask of the samples after the periods of the fundamental that ``case.discarded_periods(q)``
-    drops, ending on the last whole period."""
+    """Boolean mask of the record's samples that the fit uses (:func:`fit_window`)."""
+    return fit_window(record.t, case, q)
+
+
+def fit_window(t: np.ndarray, case: ForcedCase, q: Quality) -> np.ndarray:
+    """Boolean mask of the times ``t`` (ascending) after the periods of the fundamental that
+    ``case.discarded_periods(q)`` drops, ending on the last whole period."""
     T = 2 * math.pi / case.fundamental
-    n_whole = int(math.floor(record.t[-1] / T + 1e-9))
-    t = record.t
+    t = np.asarray(t, dtype=np.float64)
+    n_whole = int(math.floor(t[-1] / T + 1e-9))
     # from the last sample at or before the start to the first at or after the end of the last whole period:
     # a window that starts after the first period's start or ends before its last one's end is shorter than
     # its periods, and the fit (periods ending at its last sample) would lose one of them

@@ -19,7 +19,7 @@ Keys (all optional):
     grid                  "overset" (default): the section in a fine grid that moves with it over a coarser
                           fixed background (bridge/cfd/overset.py; no face of the body changes class as it
                           moves); "single": one grid, the section an immersed body moving on it (with "sst"
-                          its forces jitter as the faces change class: docs/aero.md)
+                          its forces jitter as the faces change class: docs/cfd.md, "Immersed boundary")
     turbulence            "sst" (default): the k-omega SST model (2003 variant) with Spalding's wall function on
                           the section, at the deck's Reynolds number Re = wind_speed_m_s B / nu_air ([air]
                           kinematic viscosity), on either grid (bridge/cfd/turbulence.py, docs/cfd.md);
@@ -27,13 +27,12 @@ Keys (all optional):
     sst_walls             with turbulence = "sst", the section's walls: "equilibrium" (default): Spalding's
                           wall function everywhere, with the log layer's own production of k, so that the
                           layer is turbulent from the section's front, as a deck's at Re 1e8 is
-                          (docs/aero.md, "A layer turbulent from the nose"); "function": the same wall
+                          (docs/cfd.md, "Turbulence model and walls"); "function": the same wall
                           function with the model's production of k, which leaves a layer that meets the
-                          section with the freestream's k laminar over much of it (the default until
-                          2026-12-04); "blended": the wall function where the layer next to the wall is
-                          turbulent (its eddy viscosity at least half the law's), the no-slip linear profile
-                          where it is not, so that a laminar layer can separate at a corner (under study:
-                          docs/aero.md, "The wall function on a laminar layer")
+                          section with the freestream's k laminar over much of it; "blended": the wall
+                          function where the layer next to the wall is turbulent (its eddy viscosity at
+                          least half the law's), the no-slip linear profile where it is not, so that a
+                          laminar layer can separate at a corner (under study: docs/cfd.md)
     wind_speed_m_s        the wind speed that sets the Reynolds number with turbulence = "sst" (default the
                           thesis's 50 m/s: Re = 1.05e8 for the Great Belt's 31 m); the derivatives are
                           per unit wind speed either way
@@ -49,6 +48,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
+from bridge.aero.presets import GRIDS, QUALITY, USER_SST_WALLS, check_flow_model
 from bridge.errors import InputError, check_range
 
 __all__ = ["AeroOptions"]
@@ -71,13 +71,7 @@ class AeroOptions:
     sst_walls: str = "equilibrium"
 
     def __post_init__(self):
-        from bridge.aero.forced_motion import GRIDS, QUALITY, SST_WALLS, TURBULENCE
-
-        if self.turbulence not in TURBULENCE:
-            raise InputError("aero.turbulence", self.turbulence, f"one of {', '.join(TURBULENCE)}")
-        walls = tuple(w for w in SST_WALLS if w != "resolved")   # "resolved" is the tools' diagnostic only
-        if self.sst_walls not in walls:
-            raise InputError("aero.sst_walls", self.sst_walls, f"one of {', '.join(walls)}")
+        check_flow_model(self.turbulence, self.sst_walls, USER_SST_WALLS)
         check_range("aero.wind_speed_m_s", self.wind_speed_m_s, 0.0, 200.0, low_open=True)
 
         if self.grid not in GRIDS:

@@ -4,7 +4,7 @@
 (:class:`bridge.aero.options.AeroOptions`) one heave and one pitch case (thesis 5.3: harmonic motion with
 the thesis's velocity amplitudes) of the ``[deck_section]`` (default: the Great Belt box,
 :func:`bridge.cfd.sections.great_belt_section`) in a uniform wind, on the preset grid
-(:data:`bridge.aero.forced_motion.QUALITY`); the transient periods are dropped and the FRFs fitted over
+(:data:`bridge.aero.presets.QUALITY`); the transient periods are dropped and the FRFs fitted over
 the whole periods left (:func:`bridge.aero.frequency_response.forced_motion_response`).
 
 The result is non-dimensional (CFD units B = V = rho = 1) and, with one Reynolds number per preset,
@@ -19,22 +19,16 @@ cached like every stage's and shared by bridges with the same deck (``Stage.shar
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from bridge.aero.accuracy import grid_accuracy
-from bridge.aero.forced_motion import (
-    ForcedCase,
-    StaticCase,
-    checkpoint_path,
-    preset,
-    run_cases,
-    whole_periods,
-)
+from bridge.aero.forced_motion import ForcedCase, StaticCase, checkpoint_path, run_cases, whole_periods
 from bridge.aero.frequency_response import distortion, forced_motion_response
 from bridge.aero.options import AeroOptions
+from bridge.aero.presets import preset, section_polygons
 from bridge.aero.snapshots import snapshot_files
 from bridge.aero.static import SHEDDING_THRESHOLD, StaticCoefficients, static_coefficients
 from bridge.flutter.aerodynamics import WithLateral
@@ -79,18 +73,6 @@ class AeroResult:
         return derivatives_from_frf(self.reduced_frequency, self.frf)
 
 
-def _unit_polygon(section):
-    """The section's outline scaled to chord 1 (the CFD's unit of length)."""
-    return _unit_polygons(section)[0]
-
-
-def _unit_polygons(section) -> list:
-    """Every part of the section (the box and, if any, its railings) scaled to chord 1."""
-    from bridge.cfd import Polygon
-
-    return [Polygon(p.vertices / section.chord_m) for p in section.polygons()]
-
-
 def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
     from bridge.cfd.sections import great_belt_section
 
@@ -101,16 +83,16 @@ def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
     if aopts.turbulence != "laminar":   # the deck's own Reynolds number, with the SST model
         air = getattr(scenario, "air", None)
         nu_air = air.kinematic_viscosity_m2_s if air is not None else 1.48e-5
-        q = replace(q, turbulence=aopts.turbulence, reynolds=aopts.wind_speed_m_s * section.chord_m / nu_air,
+        q = q.with_(turbulence=aopts.turbulence, reynolds=aopts.wind_speed_m_s * section.chord_m / nu_air,
                     sst_walls=aopts.sst_walls)
-    poly = _unit_polygons(section)
+    poly = section_polygons(section)
     warning = preset_warnings(q, quality, section)
     if warning:
         options.say(f"aero: WARNING {warning}")
     Ks = np.array(sorted(2 * np.pi / np.asarray(aopts.reduced_velocities)))
     runs = options.cache / "aero-runs" if options.cache is not None else None
     options.say(f"aero: {section.describe()}; {len(Ks)} reduced frequencies x heave and pitch on the "
-                f"{quality!r} preset ({aopts.grid} grid, Re = {q.reynolds:.3g}, {_flow_model(q)})")
+                f"{quality!r} preset ({aopts.grid} grid, Re = {q.physics.reynolds:.3g}, {_flow_model(q)})")
     values = {n: np.zeros(len(Ks), dtype=complex) for n in VERTICAL_TORSIONAL + ("h_qu", "h_qtheta")}
     errors = {n: np.zeros(len(Ks), dtype=complex) for n in values}
     records, cells, grids = [], 0, ""
@@ -143,7 +125,7 @@ def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
                     values[name][i] = getattr(resp.frf, name)
                     errors[name][i] = getattr(resp.stderr, name)
         if len(ks) > 1:
-            warning = _check_distortion(rec, sel, case, warning, options)
+            warning = check_distortion(rec, sel, case, warning, options)
         cells, grids = rec.meta["cells"], rec.meta["grids"]
         records.append({"dof": case.dof, "K": case.fundamental, "Ks": list(ks), "steps": rec.steps,
                         "wall_s": rec.wall_s, "resumed_from_step": rec.resumed_from_step,
@@ -160,11 +142,13 @@ def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
     measured = VERTICAL_TORSIONAL + (("h_qu", "h_qtheta") if aopts.excitation == "single" else ())
     table = DerivativeTable(Ks, derivatives_from_frf(Ks, frf), source=f"cfd ({section.name}, {quality})",
                             provides=measured)
-    table.name = f"cfd ({section.name}, {quality}, Re {q.reynolds:.3g}{', SST' if q.turbulence == 'sst' else ''})"
+    sst = ", SST" if q.physics.turbulence == "sst" else ""
+    table.name = f"cfd ({section.name}, {quality}, Re {q.physics.reynolds:.3g}{sst})"
     model = table if static is None else WithLateral(table, static.quasi_steady())
-    study, vc_error = grid_accuracy(section, aopts, quality, q.reynolds)
-    data = AeroResult(section.describe(), quality, q.reynolds, cells, Ks, frf, stderr, model, tuple(records),
-                      warning, static, tuple(static_records), aopts.grid, grids, q.turbulence, q.sst_walls,
+    study, vc_error = grid_accuracy(section, aopts, quality, q.physics.reynolds)
+    data = AeroResult(section.describe(), quality, q.physics.reynolds, cells, Ks, frf, stderr, model,
+                      tuple(records), warning, static, tuple(static_records), aopts.grid, grids, q.physics.turbulence,
+                      q.physics.sst_walls,
                       study, vc_error)
     return StageOutput(summary=_summary(data), write_h5=lambda g: _write_h5(g, data), report=_report(data),
                        figures=_figures(data), data=data)
@@ -173,11 +157,11 @@ def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
 def preset_warnings(q, quality: str, section) -> str:
     """What the stage warns of before its runs, for the preset ``q`` (named ``quality``) and the section:
     a section fewer than 2 cells thick, SST finer than its tested grids, the blended wall (under study)."""
-    cells_across = (section.depth_m / section.chord_m) * q.cells_per_chord / q.dy_over_dx
+    cells_across = (section.depth_m / section.chord_m) * q.grid.cells_per_chord / q.grid.dy_over_dx
     notes = [] if cells_across >= 2.0 else [
         f"the section is {cells_across:.1f} cells thick on the {quality!r} grid (fewer than 2): the immersed "
         "boundary barely sees it and the forces are not to be trusted; use a finer preset"]
-    h = section.chord_m / q.cells_per_chord      # the body grid's cell along the chord (its larger side)
+    h = section.chord_m / q.grid.cells_per_chord      # the body grid's cell along the chord (its larger side)
     for i, part in enumerate(section.polygons()[1:], start=2):
         x, y = part.vertices[:, 0], part.vertices[:, 1]
         perimeter = float(np.hypot(np.diff(x, append=x[0]), np.diff(y, append=y[0])).sum())
@@ -188,19 +172,22 @@ def preset_warnings(q, quality: str, section) -> str:
                          f"of the {quality!r} grid (fewer than 2): the grid barely sees it and its share of the "
                          f"forces is not to be trusted; two cells across it take {need} cells per chord "
                          "('fine' has 80)")
-    if q.turbulence == "sst" and q.cells_per_chord > 80:
-        notes.append(f"SST on the {quality!r} preset ({q.cells_per_chord} cells per chord) is untested: the finest SST "
-                     "runs had 80 cells per chord (the Great Belt deck's grid study, docs/aero.md); a run that "
+    if q.physics.turbulence == "sst" and q.grid.cells_per_chord > 80:
+        notes.append(f"SST on the {quality!r} preset ({q.grid.cells_per_chord} cells per chord) is untested: the "
+                     "finest SST "
+                     "runs had 80 cells per chord (the Great Belt deck's grid study, docs/aero.md, \"Grid study\"); a "
+                     "run that "
                      "diverges stops with exit status 3")
-    if q.turbulence == "sst" and q.sst_walls == "blended":
+    if q.physics.turbulence == "sst" and q.physics.sst_walls == "blended":
         notes.append("[aero] sst_walls = \"blended\" is under study: it brought the thin plate onto a body-fitted "
                      "code's, but on the Great Belt deck at Re 1e8 on the 16-cell 'quick' grid it turned the static "
-                     "lift slope negative and A2* positive (docs/aero.md, \"The wall function on a laminar layer\")")
+                     "lift slope negative and A2* positive (docs/cfd.md, \"Turbulence model and walls\")")
     return "; ".join(notes)
 
 
 def _flow_model(q) -> str:
-    return "laminar" if q.turbulence == "laminar" else f"k-omega SST-2003 with {_WALLS[q.sst_walls]}"
+    physics = q.physics
+    return "laminar" if physics.turbulence == "laminar" else f"k-omega SST-2003 with {_WALLS[physics.sst_walls]}"
 
 
 _WALLS = {"function": "Spalding's wall function", "blended": "Spalding's wall function where the layer is turbulent",
@@ -212,7 +199,7 @@ _WALLS = {"function": "Spalding's wall function", "blended": "Spalding's wall fu
 DISTORTION_LIMIT = 0.03
 
 
-def _check_distortion(rec, sel, case: ForcedCase, warning: str, options: RunOptions) -> str:
+def check_distortion(rec, sel, case: ForcedCase, warning: str, options: RunOptions) -> str:
     """Warn when a multi-frequency run's lift or moment is not linear in the motion (``distortion``); returns
     the stage's warning with the finding added."""
     worst = max((distortion(rec.t[sel], getattr(rec, load)[sel], case.reduced_frequencies, case.fundamental), load)
@@ -299,10 +286,10 @@ def _write_h5(group: Any, d: AeroResult) -> None:
             write_dataset(group, f"derivatives/{name}", v, "1",
                           f"({n},) Scanlan's {name}* (B form, h and L down, alpha and M nose-up)")
     if d.static is not None:
-        _write_static_h5(group.create_group("static"), d.static)
+        write_static_h5(group.create_group("static"), d.static)
 
 
-def _write_static_h5(g: Any, st: StaticCoefficients) -> None:
+def write_static_h5(g: Any, st: StaticCoefficients) -> None:
     """``results.h5:/aero/static``: coefficients of the section held still (bridge/aero/static.py)."""
     n = st.angles_deg.size
     g.attrs["window_start"], g.attrs["window_end"] = st.window
@@ -355,7 +342,7 @@ def _report(d: AeroResult) -> str:
             row += [f"{np.asarray(getattr(der, name))[i]:.3f}", f"{np.asarray(getattr(theo, name))[i]:.3f}"]
         lines.append("| " + " | ".join(row) + " |")
     if d.static is not None:
-        lines += _static_report(d.static)
+        lines += static_report(d.static)
     lines += ["", "Cases: " + "; ".join(f"{r['dof']} K = {_ks(r)}: {r['steps']} steps, {r['periods']} periods "
                                        f"fitted, {r['wall_s']:.0f} s" + (f" (resumed at step {r['resumed_from_step']})"
                                                                          if r["resumed_from_step"] else "")
@@ -367,7 +354,7 @@ def _ks(record: dict) -> str:
     return ", ".join(f"{k:.3f}" for k in record["Ks"])
 
 
-def _static_report(st: StaticCoefficients) -> list[str]:
+def static_report(st: StaticCoefficients) -> list[str]:
     lines = ["", "Static coefficients (section held still; means over t V/B in "
              f"[{st.window[0]:.1f}, {st.window[1]:.1f}]; on B, moment nose-up about the reference point):", "",
              "| angle [deg] | C_D | C_L | C_M | lift rms | St = f D / V | settling (C_D, C_L, C_M) |",

@@ -24,7 +24,7 @@ neighbour that the projection then moves by c G p, a wall-profile error of order
 estimate the error is of order dt^2, as in the incremental form; DFG 2D-2's lift amplitude rose by
 1.8 % at D/16 and 0.8 % at D/32 (docs/validation.md).
 
-Mass (``_close_targets``): a cell whose four faces are all forced (solid faces and interface faces
+Mass (``close_targets``): a cell whose four faces are all forced (solid faces and interface faces
 together) gets no free face for the projection to adjust, and the interpolated interface targets
 do not in general add up to zero flux there. Left alone, the projection carried the mismatch through
 the body (solid faces at 1-2 % of the mean flow in DFG 2D-1, not shrinking with h), the pressure inside
@@ -69,11 +69,11 @@ class ImmersedBody:
     """A rigid polygon on a grid: classifies faces, applies the forcing, returns forces.
 
     ``apply`` mutates the predicted velocity in place. ``margin`` cells surround the body's box;
-    ``stages``: of the time scheme (the forcing impulse is kept per stage).
+    ``substeps``: of the time scheme (the Runge-Kutta stages; the forcing impulse is kept per substep).
     """
 
     def __init__(self, polygon: Polygon, motion, grid: CartesianGrid, launcher, margin: int = 3,
-                 order: int = 1, stages: int = 2):
+                 order: int = 1, substeps: int = 2):
         if margin < 2:
             raise ValueError(f"margin: must be >= 2 cells, got {margin}")
         if order not in (1, 2):
@@ -85,7 +85,7 @@ class ImmersedBody:
         dev = launcher.device
         self.margin = margin
         self.verts = wp.array(polygon.vertices, dtype=wp.vec2d, device=dev)
-        self.acc = wp.zeros(3 * stages, dtype=WP_DTYPE, device=dev)   # (F_x, F_y, M_z) impulse per stage
+        self.acc = wp.zeros(3 * substeps, dtype=WP_DTYPE, device=dev)   # (F_x, F_y, M_z) impulse per stage
         g = GHOST
         self.yc_u = wp.array(grid.storage_y_centres(), dtype=WP_DTYPE, device=dev)
         self.yc_v = wp.array(grid.storage_y_faces(), dtype=WP_DTYPE, device=dev)
@@ -182,7 +182,7 @@ class ImmersedBody:
                                                  float(c), int(p is not None),
                                                  q if self._nu_eff is None else self._nu_eff,
                                                  b["target"], b["state"]])
-        self._close_targets()
+        self.close_targets()
         for comp, q in ((0, u), (1, v)):
             b = self.boxes[comp]
             yc = self.yc_u if comp == 0 else self.yc_v
@@ -234,7 +234,7 @@ class ImmersedBody:
         return {"A": A, "solve": factorized(M), "faces": [f[:3] for f in faces],
                 "unknown": [(c, comp == c, unknown[comp == c] - c * big) for c in (0, 1)]}
 
-    def _close_targets(self):
+    def close_targets(self):
         """Least change of the interface targets that leaves every all-forced cell divergence-free."""
         if self._closure_pose != self._pose:
             self._closure_data = self._closure()

@@ -109,6 +109,11 @@ class RowLauncher:
         rec.scalars = scalars
         rec.cmd.launch()
 
+    @property
+    def n_records(self) -> int:
+        """Launches recorded and kept for replay."""
+        return len(self._records)
+
     def forget(self):
         """Drop every recorded launch (and the array references the records hold)."""
         with self._lock:

@@ -1,24 +1,29 @@
-"""Monitors: small objects the time loop calls after every step (PyFR-plugin style).
+"""Monitors: small objects the time loop (bridge.cfd.flow.run) calls after every step (PyFR-plugin style).
 
-Each monitor has ``__call__(sim)``; ``every`` sets how often it works. ``run`` is the loop.
+Each monitor has ``__call__(flow)``; ``every`` sets how often it works.  ``ForceHistory``, ``CFLMonitor`` and
+``DivergenceMonitor`` read one ``Simulation``; ``NaNMonitor``, ``ProgressNote`` and ``Checkpoint`` work on any
+flow (bridge.cfd.flow.Flow).
 """
 
 from __future__ import annotations
 
-import math
+import os
 import sys
+import tempfile
 import time
 from collections.abc import Callable
+from pathlib import Path
 
 import numpy as np
 
 from kernels import cfd as _k
 
+from .flow import FlowDiverged, run
 from .grids import GHOST
 from .launch import ROW0
-from .time_stepping import FlowDiverged, Simulation
+from .time_stepping import Simulation
 
-__all__ = ["ForceHistory", "CFLMonitor", "DivergenceMonitor", "NaNMonitor", "ProgressNote", "run",
+__all__ = ["ForceHistory", "CFLMonitor", "DivergenceMonitor", "NaNMonitor", "ProgressNote", "Checkpoint", "run",
            "max_divergence"]
 
 
@@ -119,51 +124,88 @@ class DivergenceMonitor:
 
 
 class NaNMonitor:
-    """Stops the run on a non-finite velocity: restores the last good state (checked every
-    ``every`` steps, copies kept on the host) and raises ``FlowDiverged`` with where and when."""
+    """Stops the run on a non-finite velocity or pressure in any grid of the flow: restores the last good
+    state (checked every ``every`` steps, copies kept on the host) and raises ``FlowDiverged`` with where and
+    when."""
 
     def __init__(self, every: int = 20):
         self.every = every
         self.good = None
 
-    def __call__(self, sim: Simulation):
-        if sim.n_steps % self.every:
+    def __call__(self, flow):
+        if flow.n_steps % self.every:
             return
-        arrays = {name: getattr(sim, name).numpy() for name in ("u", "v", "p")}
-        bad = [name for name, a in arrays.items() if not np.isfinite(a).all()]
+        sims = getattr(flow, "simulations", [flow])
+        arrays = [{name: getattr(sim, name).numpy() for name in ("u", "v", "p")} for sim in sims]
+        bad = [(n, name) for n, a in enumerate(arrays) for name, x in a.items() if not np.isfinite(x).all()]
         if not bad:
-            self.good = (sim.t, sim.n_steps, {k: a.copy() for k, a in arrays.items()})
+            self.good = (flow.t, flow.n_steps, [{k: x.copy() for k, x in a.items()} for a in arrays])
             return
-        where = np.argwhere(~np.isfinite(arrays[bad[0]]))[0]
-        msg = (f"non-finite {bad} at t={sim.t:.6g} (step {sim.n_steps}), first at storage index "
+        n, name = bad[0]
+        where = np.argwhere(~np.isfinite(arrays[n][name]))[0]
+        grid = "" if len(sims) == 1 else f" in grid {n}"
+        msg = (f"non-finite {name}{grid} at t={flow.t:.6g} (step {flow.n_steps}), first at storage index "
                f"{tuple(int(w) for w in where)}")
         if self.good is not None:
-            t, n, saved = self.good
-            for k, a in saved.items():
-                getattr(sim, k).assign(a)
-            sim.t, sim.n_steps = t, n
-            msg += f"; state restored to the last good one at t={t:.6g} (step {n})"
+            t, steps, saved = self.good
+            for sim, fields in zip(sims, saved, strict=True):
+                for k, x in fields.items():
+                    getattr(sim, k).assign(x)
+                sim.t, sim.n_steps = t, steps
+            flow.t, flow.n_steps = t, steps
+            msg += f"; state restored to the last good one at t={t:.6g} (step {steps})"
         raise FlowDiverged(msg)
 
 
-def run(sim: Simulation, t_end: float, monitors=(), max_steps: int | None = None,
-        land_exactly: bool = False) -> Simulation:
-    """Advance ``sim`` until t >= ``t_end``, calling the monitors after every step.
+class Checkpoint:
+    """Writes the flow's whole state (``Flow.checkpoint_arrays``, its time and steps) and the columns that
+    ``record()`` returns (a force record so far) to the HDF5 file ``path`` every ``every`` steps, atomically
+    (a temporary file renamed over the old one), tagged with ``key``: what a checkpoint must match to be
+    resumed (the case, the grid, the code).  ``resume(flow)`` loads a matching file into the flow and returns
+    its record (None: no file, another key, or unreadable: start afresh); ``save(flow)`` writes now."""
 
-    With ``land_exactly`` the last step is shortened to end on t_end; off by default because a
-    sudden change of dt shows up as a one-step blip in the direct-forcing force history.
-    """
-    n = 0
-    while sim.t < t_end - 1e-12 * max(1.0, abs(t_end)):
-        dt = sim.stable_dt()
-        if land_exactly:
-            dt = min(dt, t_end - sim.t)
-        sim.step(dt)
-        n += 1
-        for m in monitors:
-            m(sim)
-        if max_steps is not None and n >= max_steps:
-            break
-    if not math.isfinite(sim.t):
-        raise FlowDiverged("time became non-finite")
-    return sim
+    def __init__(self, path: str | Path, key: str, every: int, record: Callable[[], dict]):
+        if every < 1:
+            raise ValueError(f"every: must be >= 1, got {every}")
+        self.path, self.key, self.every, self.record = Path(path), str(key), int(every), record
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+
+    def __call__(self, flow) -> None:
+        if flow.n_steps % self.every == 0:
+            self.save(flow)
+
+    def save(self, flow) -> None:
+        import h5py
+
+        fd, tmp = tempfile.mkstemp(dir=self.path.parent, prefix=f".{self.path.name}.", suffix=".tmp")
+        os.close(fd)
+        try:
+            with h5py.File(tmp, "w") as h5:
+                h5.attrs["case_key"] = self.key
+                h5.attrs["t"] = flow.t
+                h5.attrs["n_steps"] = flow.n_steps
+                for name, values in flow.checkpoint_arrays().items():
+                    h5.create_dataset(f"state/{name}", data=values)
+                for name, values in self.record().items():
+                    h5.create_dataset(f"record/{name}", data=np.asarray(values))
+            os.replace(tmp, self.path)
+        except BaseException:
+            Path(tmp).unlink(missing_ok=True)
+            raise
+
+    def resume(self, flow) -> dict | None:
+        import h5py
+
+        if not self.path.is_file():
+            return None
+        try:
+            with h5py.File(self.path, "r") as h5:
+                if h5.attrs.get("case_key") != self.key:
+                    return None
+                arrays = {}
+                h5["state"].visititems(lambda name, obj: arrays.__setitem__(name, obj[()])
+                                       if isinstance(obj, h5py.Dataset) else None)
+                flow.restore_arrays(arrays, float(h5.attrs["t"]), int(h5.attrs["n_steps"]))
+                return {name: list(h5[f"record/{name}"][()]) for name in h5["record"]}
+        except (OSError, KeyError, ValueError):   # unreadable or of another grid: start afresh
+            return None

@@ -1,7 +1,7 @@
 """Overset (chimera) pair: a fine uniform grid that moves rigidly with the body over a fixed background.
 
 Why: on one fixed grid a moving immersed body changes which faces it forces every step, and that
-error depends on the body's path through the cells (docs/aero.md: the heave FRFs moved by 10-40 %
+error depends on the body's path through the cells (the heave FRFs moved by 10-40 %
 with the amplitude); and refining at the body refines the whole domain (x must stay uniform for the
 direct Poisson solver). Here the body is an immersed boundary fixed in its own grid, so no face
 changes class as it moves, and only the body grid is fine.
@@ -54,13 +54,15 @@ from dataclasses import replace
 import numpy as np
 import warp as wp
 
+from bridge.errors import InternalError
 from kernels import cfd as _k
 
 from .bodies import Polygon
 from .boundaries import BoundaryConditions
+from .flow import LAMINAR, FlowBase
 from .grids import GHOST, CartesianGrid
 from .immersed import ImmersedBody
-from .time_stepping import FlowConfig, Simulation, StageHook
+from .time_stepping import FlowConfig, Simulation, SubstepHook
 
 __all__ = ["OversetPair", "CornerInterpolator", "stream_function"]
 
@@ -86,7 +88,7 @@ class CornerInterpolator:
     def __call__(self, field: np.ndarray, px: np.ndarray, py: np.ndarray) -> np.ndarray:
         field = np.ascontiguousarray(field, dtype=np.float64)
         if field.shape != (self.y_nodes.size, self.nx):
-            raise ValueError(f"CornerInterpolator: field {field.shape}, lattice {(self.y_nodes.size, self.nx)}")
+            raise InternalError(f"CornerInterpolator: field {field.shape}, lattice {(self.y_nodes.size, self.nx)}")
         px = np.ascontiguousarray(px, dtype=np.float64).reshape(-1)
         py = np.ascontiguousarray(py, dtype=np.float64).reshape(-1)
         out = np.empty(px.size)
@@ -135,8 +137,8 @@ class _FrameMotion:
 class _FrameBody(ImmersedBody):
     """The immersed body fixed in the body grid; its force in the inertial frame (module doc)."""
 
-    def __init__(self, polygon, motion, grid, launcher, margin=3, stages=2):
-        super().__init__(polygon, _FrameMotion(motion), grid, launcher, margin, stages=stages)
+    def __init__(self, polygon, motion, grid, launcher, margin=3, substeps=2):
+        super().__init__(polygon, _FrameMotion(motion), grid, launcher, margin, substeps=substeps)
         self.inertial = motion
 
     def _centroid_inertial(self, t):
@@ -159,7 +161,7 @@ class _FrameBody(ImmersedBody):
         return rho * np.array([*(R @ f_b), mz])
 
 
-class _Fringe(StageHook):
+class _Fringe(SubstepHook):
     """Body grid: frame velocity before each predictor, boundary faces after it, fringe after each
     projection, all from the background's stream function at the stage's time."""
 
@@ -216,7 +218,7 @@ class _Fringe(StageHook):
         self.pair.sync_device(sim, (u, hu), (v, hv))
 
 
-class _Hole(StageHook):
+class _Hole(SubstepHook):
     """Background: the faces inside the hole take the body grid's velocity (module doc)."""
 
     def __init__(self, pair: OversetPair):
@@ -239,9 +241,10 @@ class _Hole(StageHook):
         self.pair.sync_device(sim, (sim.u_star, us), (sim.v_star, vs))
 
 
-class OversetPair:
+class OversetPair(FlowBase):
     """A fixed background ``Simulation`` and a body ``Simulation`` on a uniform grid in body
-    coordinates, coupled every stage (module doc).
+    coordinates, coupled every stage (module doc): a flow (bridge.cfd.flow.Flow), whose turbulence model
+    is one of both grids (``OversetSST(pair, ...)`` makes itself the pair's model).
 
     ``body_grid``: uniform ``CartesianGrid`` in the body's coordinates (the reference point at 0);
     ``motion``: the body's rigid motion (pose(t), velocity(t)); ``polygon``: the body in its own
@@ -263,7 +266,7 @@ class OversetPair:
                                device=device)
         polygons = [] if polygon is None else list(polygon) if isinstance(polygon, (list, tuple)) else [polygon]
         for poly in polygons:
-            self.body.bodies.append(_FrameBody(poly, motion, body_grid, self.body.L, stages=len(self.body.stages)))
+            self.body.bodies.append(_FrameBody(poly, motion, body_grid, self.body.L, substeps=len(self.body.substeps)))
             self.body.last_force.append(np.zeros(3))
         gbg, gb = background_grid, body_grid
         self._body_interp = CornerInterpolator(gb.x_faces, gb.y_faces)
@@ -293,7 +296,7 @@ class OversetPair:
         self.body.hooks.append(self._fringe)
         self.background.hooks.append(self._hole)
         self._psi_hist: list[tuple[float, np.ndarray]] = []   # (t, body psi) of the last two steps
-        self.model = None   # a turbulence model of both grids (bridge.cfd.turbulence.OversetSST), or None
+        self.turbulence = LAMINAR   # or a model of both grids (bridge.cfd.turbulence.OversetSST)
         self.t = 0.0
         self.n_steps = 0
 
@@ -411,33 +414,30 @@ class OversetPair:
         return (ju + j0 + g, iu + i0 + g, tu, gu), (jv + j0 + g, iv + i0 + g, tv, gv)
 
     # --- step ---------------------------------------------------------------------------------
-    def stable_dt(self) -> float:
-        """The smaller of the grids' (and the model's) limits, the body grid's with the velocity relative
-        to it at the step's start (set here, so that a run resumed from a checkpoint, whose grid has no
-        frame velocity yet, takes the same step as one that was never stopped)."""
+    def _flow_dt(self) -> float:
+        """The smaller of the grids' limits, the body grid's with the velocity relative to it at the step's
+        start (set here, so that a run resumed from a checkpoint, whose grid has no frame velocity yet, takes
+        the same step as one that was never stopped); ``stable_dt`` adds the turbulence model's."""
         self.body.set_frame_velocity(*self.frame_velocity(self.t))
-        dt = min(self.background.stable_dt(), self.body.stable_dt())
-        return dt if self.model is None else min(dt, self.model.stable_dt())
+        return min(self.background.stable_dt(), self.body.stable_dt())
 
-    def step(self, dt: float | None = None) -> float:
-        """Advance both grids by one step: the background first (hole from the body grid extrapolated
-        to the new time), then the body grid (fringe from the background at the new time); then the
-        turbulence model, if any, with the new velocities."""
-        dt = self.stable_dt() if dt is None else float(dt)
+    def _advance_flow(self, dt: float) -> None:
+        """Both grids by one step: the background first (hole from the body grid extrapolated to the new
+        time), then the body grid (fringe from the background at the new time); ``step`` then advances the
+        turbulence model with the new velocities."""
         self.background.step(dt)
         self.body.step(dt)
         self.t = self.body.t
         self._psi_hist = [self._psi_hist[-1], (self.t, stream_function(self.body))]
-        if self.model is not None:
-            self.model.advance(dt)
         self.n_steps += 1
-        return dt
 
     @property
-    def last_force(self) -> np.ndarray:
+    def total_force(self) -> np.ndarray:
         """(F_x, F_y, M_z) on the body (all its polygons) over the last step, inertial axes, M_z about
         the body's reference point (zeros without a body)."""
-        return np.sum(self.body.last_force, axis=0) if self.body.bodies else np.zeros(3)
+        return self.body.total_force
+
+    last_force = total_force   # the pair's loads are always the sum over its polygons
 
     @property
     def n_cells(self) -> int:
@@ -450,7 +450,8 @@ class OversetPair:
 
     def describe(self) -> str:
         b, g = self.background.grid, self.body.grid
-        return f"{b.nx} x {b.ny} + body {g.nx} x {g.ny} cells" + ("" if self.model is None else ", SST")
+        model = "" if self.turbulence is LAMINAR else f", {self.turbulence.name.upper()}"
+        return f"{b.nx} x {b.ny} + body {g.nx} x {g.ny} cells{model}"
 
     # --- checkpoint ---------------------------------------------------------------------------
     def checkpoint_arrays(self) -> dict[str, np.ndarray]:

@@ -40,6 +40,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from ..errors import InputError, check_range
+from ..toml_table import Table
 from .bodies import Polygon
 
 __all__ = ["FlatPlate", "Rectangle", "StreamlinedBox", "PolygonSection", "SECTIONS", "section_from_mapping",
@@ -389,9 +390,7 @@ class PolygonSection(_Section):
             for i, part in enumerate(self.parts):
                 key = f"{WHERE}.parts[{i}]"
                 if isinstance(part, Mapping):  # the [[deck_section.parts]] form
-                    from ..config import _Table
-
-                    table = _Table(part, key)
+                    table = Table(part, key)
                     part = table.raw("vertices")
                     table.done()
                 parts.append(_point_list(key, part))
@@ -486,10 +485,7 @@ def section_from_mapping(mapping: Mapping[str, Any], where: str = WHERE,
     (shape "polygon") is taken from, the scenario file's (default: the working directory); the file is
     read and checked here.
     """
-    from ..config import _Table  # the scenario reader's key tracking (one validation path); lazy:
-    # bridge.config may read [deck_section] through this module
-
-    table = _Table(mapping, where)
+    table = Table(mapping, where)
     cls = SECTIONS[table.string("shape", choices=tuple(SECTIONS))]
     values = {}
     for f in fields(cls):

@@ -34,13 +34,14 @@ from kernels import cfd as _k
 
 from .advection import scheme_code
 from .boundaries import BoundaryConditions, BoundaryOperator
+from .flow import LAMINAR, FlowBase, FlowDiverged
 from .grids import GHOST, CartesianGrid
 from .launch import ROW0, RowLauncher
 from .precision import WP_DTYPE
 from .pressure import PoissonSolver
 from .state import FlowState
 
-__all__ = ["FlowConfig", "Simulation", "StageHook", "TIME_SCHEMES", "FlowDiverged"]
+__all__ = ["FlowConfig", "Simulation", "SubstepHook", "TIME_SCHEMES", "FlowDiverged"]
 
 # Shu-Osher form: stage k: u_{k+1} = a_k u^n + b_k (u_k + dt L(u_k)).
 TIME_SCHEMES = {
@@ -49,7 +50,7 @@ TIME_SCHEMES = {
 }
 
 
-class StageHook:
+class SubstepHook:
     """Called by ``Simulation.step`` in every stage (defaults do nothing): ``before_predict`` with the
     time of the stage's input, ``after_predict`` once the predicted ``u_star``/``v_star`` have their
     boundary faces (before the bodies' forcing and the projection), ``after_projection`` once the
@@ -63,10 +64,6 @@ class StageHook:
 
     def after_projection(self, sim: Simulation, k: int, u, v, t_new: float) -> None:
         pass
-
-
-class FlowDiverged(RuntimeError):
-    """Raised by a monitor when the solution stops being finite."""
 
 
 @dataclass(frozen=True)
@@ -105,23 +102,25 @@ class FlowConfig:
             raise ValueError(f"threads: must be >= 1, got {self.threads}")
 
 
-class Simulation:
-    """Solver state on one grid plus the step assembled from its parts.
+class Simulation(FlowBase):
+    """Solver state on one grid plus the step assembled from its parts: a flow (bridge.cfd.flow.Flow).
 
     Public arrays (Warp, storage layout of ``grids``): ``u``, ``v``, ``p``, ``nu``. ``step(dt)``
-    advances them in place by one time step; ``t`` is the time of the state.
+    advances them in place by one time step, then the turbulence model the simulation owns, if any
+    (``KOmegaSST(sim, ...)`` makes itself the simulation's model); ``t`` is the time of the state.
     """
 
     def __init__(self, grid: CartesianGrid, config: FlowConfig, bodies=(), device: str | None = None,
                  poisson=None):
         self.grid, self.config = grid, config
+        self.turbulence = LAMINAR
         self.L = RowLauncher(device, config.threads)
         dev = self.L.device
         g, nx, ny = GHOST, grid.nx, grid.ny
         self.bc = BoundaryOperator(config.bc, grid, self.L)
         self.poisson = poisson if poisson is not None else PoissonSolver(grid, launcher=self.L)
         self.scheme = scheme_code(config.advection)
-        self.stages = TIME_SCHEMES[config.time_scheme]
+        self.substeps = TIME_SCHEMES[config.time_scheme]
         self.bodies = list(bodies)
 
         def z(shape):
@@ -132,11 +131,11 @@ class Simulation:
         self.state = FlowState()   # what a resumed run needs; models add their fields (bridge.cfd.state)
         for name in "uvp":
             self.state.register(name, getattr(self, name))
-        self.u_stage, self.v_stage = z(ushape), z(vshape)
+        self.u_sub, self.v_sub = z(ushape), z(vshape)
         self.u_star, self.v_star = z(ushape), z(vshape)
         # predictor row blocks: one per CPU thread (the y-flux carried up the block), short blocks on CUDA
         self.n_blocks = self.L.threads if dev.is_cpu else max(1, ny // 4)
-        self._scratch = z((2 * self.n_blocks, nx + 1 + 2 * g))  # two y-flux rows per block
+        self.yflux_scratch = z((2 * self.n_blocks, nx + 1 + 2 * g))  # two y-flux rows per block
         self.nu = wp.full(pshape, config.nu, dtype=WP_DTYPE, device=dev)
         self.rhs = z((ny, nx))  # D u* / c, overwritten in place by phi (the Poisson solve)
         self.hy_c = wp.array(grid.hy_cells(), dtype=WP_DTYPE, device=dev)
@@ -155,7 +154,7 @@ class Simulation:
         self._frame_coords = (grid.storage_y_centres(), grid.storage_y_faces(),
                               grid.x_faces[0] + (np.arange(pshape[1]) - g + 0.5) * grid.dx,
                               grid.x_faces[0] + (np.arange(ushape[1]) - g) * grid.dx)
-        self.hooks: list[StageHook] = []   # the overset coupling's frame and fringe (bridge.cfd.overset)
+        self.hooks: list[SubstepHook] = []   # the overset coupling's frame and fringe (bridge.cfd.overset)
         self.last_force = [np.zeros(3) for _ in self.bodies]
         self.nu_max = config.nu
         self.nu_rows = None   # largest nu of each cell row (ny,), where a viscosity field sets it (stable_dt)
@@ -170,7 +169,7 @@ class Simulation:
         """Immerse a rigid polygon moving with ``motion``; returns the ``ImmersedBody``."""
         from .immersed import ImmersedBody
 
-        body = ImmersedBody(polygon, motion, self.grid, self.L, margin, stages=len(self.stages))
+        body = ImmersedBody(polygon, motion, self.grid, self.L, margin, substeps=len(self.substeps))
         self.bodies.append(body)
         self.last_force.append(np.zeros(3))
         return body
@@ -256,6 +255,10 @@ class Simulation:
 
     # --- time step ---------------------------------------------------------------------------------
     def stable_dt(self) -> float:
+        """The fixed dt if configured; else the flow's limit (below) and the turbulence model's, the smaller."""
+        return self.config.dt if self.config.dt is not None else super().stable_dt()
+
+    def _flow_dt(self) -> float:
         """dt from the convective and viscous limits together; the fixed dt if configured.
 
         1/dt = rate/cfl + nu_max/(fourier h_min^2), rate = max|u|/dx + max|v|/hy (velocities relative to
@@ -294,10 +297,10 @@ class Simulation:
         common = [self.hy_c, self.hy_f, dx, dt, a, b]
         frame = [self.frame_x, self.frame_xf, self.frame_y, self.frame_yu, self.frame_omega]
         self.L.rows(_k.predict_u, nb, 0, [src_u, src_v, self.p, self.nu, u0, self.u_star, *common,
-                                          g + 1, g + nx, g, ny, nb, use_p, s, ROW0, self._scratch, *frame],
+                                          g + 1, g + nx, g, ny, nb, use_p, s, ROW0, self.yflux_scratch, *frame],
                     min_split=2)
         self.L.rows(_k.predict_v, nb, 0, [src_u, src_v, self.p, self.nu, v0, self.v_star, *common,
-                                          g, g + nx, g + 1, ny - 1, nb, use_p, s, ROW0, self._scratch, *frame],
+                                          g, g + nx, g + 1, ny - 1, nb, use_p, s, ROW0, self.yflux_scratch, *frame],
                     min_split=2)
 
     def _project(self, dst_u, dst_v, c):
@@ -312,20 +315,20 @@ class Simulation:
         self.L.rows(_k.project, ny, 0, [self.u_star, self.v_star, self.rhs, self.hy_f, self.grid.dx, c,
                                         g, nx, ny, acc, ROW0, dst_u, dst_v, self.p])
 
-    def step(self, dt: float | None = None) -> float:
-        """Advance the state by one step (in place); returns the dt used."""
-        dt = self.stable_dt() if dt is None else float(dt)
+    def _advance_flow(self, dt: float) -> None:
+        """Advance the velocity and pressure by one step of ``dt`` (in place); ``step`` then advances the
+        turbulence model."""
         t_new = self.t + dt
         for body in self.bodies:
             body.update(t_new)
             body.reset_impulse()
         src_u, src_v = self.u, self.v
-        n = len(self.stages)
+        n = len(self.substeps)
         p_comp = self.p if self.config.pressure == "full" else None  # forcing compensation (immersed.py)
 
-        for k, (a, b) in enumerate(self.stages):
+        for k, (a, b) in enumerate(self.substeps):
             last = k == n - 1
-            dst_u, dst_v = (self.u, self.v) if last else (self.u_stage, self.v_stage)
+            dst_u, dst_v = (self.u, self.v) if last else (self.u_sub, self.v_sub)
             for hook in self.hooks:   # the stage's input is at t (first stage) or t_new (SSP RK2/Euler)
                 hook.before_predict(self, k, self.t if k == 0 else t_new)
             self._predict(src_u, src_v, self.u, self.v, dt, a, b)
@@ -339,9 +342,35 @@ class Simulation:
             for hook in self.hooks:
                 hook.after_projection(self, k, dst_u, dst_v, t_new)
             src_u, src_v = dst_u, dst_v
-        weights = [float(np.prod([bb for _, bb in self.stages[k + 1:]])) for k in range(n)]
+        weights = [float(np.prod([bb for _, bb in self.substeps[k + 1:]])) for k in range(n)]
         self.last_force = [body.force(weights, dt, self.t, t_new, self.config.rho) for body in self.bodies]
         self.last_dt = dt
         self.t = t_new
         self.n_steps += 1
-        return dt
+
+    # --- the rest of the Flow protocol (bridge.cfd.flow) -------------------------------------------
+    @property
+    def total_force(self) -> np.ndarray:
+        """(F_x, F_y, M_z) on all the bodies over the last step (``last_force`` holds each body's)."""
+        return np.sum(self.last_force, axis=0) if self.last_force else np.zeros(3)
+
+    @property
+    def simulations(self) -> list[Simulation]:
+        return [self]
+
+    @property
+    def n_cells(self) -> int:
+        return self.grid.nx * self.grid.ny
+
+    def describe(self) -> str:
+        model = "" if self.turbulence is LAMINAR else f", {self.turbulence.name.upper()}"
+        return f"{self.grid.nx} x {self.grid.ny} cells{model}"
+
+    def checkpoint_arrays(self) -> dict[str, np.ndarray]:
+        """The state a resumed run needs to continue bit for bit: the flow's and its turbulence model's
+        fields (bridge.cfd.state)."""
+        return self.state.arrays()
+
+    def restore_arrays(self, arrays: dict[str, np.ndarray], t: float, n_steps: int) -> None:
+        self.state.assign(arrays)
+        self.t, self.n_steps = float(t), int(n_steps)

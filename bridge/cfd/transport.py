@@ -20,6 +20,7 @@ from __future__ import annotations
 import numpy as np
 import warp as wp
 
+from bridge.errors import InternalError
 from kernels import transport as _t
 
 from .grids import GHOST
@@ -128,10 +129,10 @@ class TransportedScalar:
         sim, g, grid = self.sim, GHOST, self.sim.grid
         u = sim.u if u is None else u
         v = sim.v if v is None else v
-        stages = sim.stages
+        substeps = sim.substeps
         src = self.q
-        for k, (a, b) in enumerate(stages):
-            out = self._next if k == len(stages) - 1 else self._stage
+        for k, (a, b) in enumerate(substeps):
+            out = self._next if k == len(substeps) - 1 else self._stage
             sim.L.rows(_t.scalar_stage, grid.ny, g,
                        [src, u, v, self.gamma, self.source, self.sink, self.q, out, sim.hy_c, sim.hy_f,
                         sim.frame_x, sim.frame_y, grid.dx, float(dt), float(a), float(b), g, g + grid.nx,
@@ -146,13 +147,13 @@ def advance_pair(first: TransportedScalar, second: TransportedScalar, dt: float,
     numbers as advancing each alone (``kernels.transport.scalar_pair_stage``), the velocity read once."""
     sim, g = first.sim, GHOST
     if second.sim is not sim:
-        raise ValueError("advance_pair: both scalars must live on the same Simulation")
+        raise InternalError("advance_pair: both scalars must live on the same Simulation")
     grid = sim.grid
     u = sim.u if u is None else u
     v = sim.v if v is None else v
     src1, src2 = first.q, second.q
-    for k, (a, b) in enumerate(sim.stages):
-        last = k == len(sim.stages) - 1
+    for k, (a, b) in enumerate(sim.substeps):
+        last = k == len(sim.substeps) - 1
         out1 = first._next if last else first._stage
         out2 = second._next if last else second._stage
         sim.L.rows(_t.scalar_pair_stage, grid.ny, g,

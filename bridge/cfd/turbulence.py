@@ -44,7 +44,7 @@ from .grids import GHOST
 from .launch import ROW0
 from .transport import TransportedScalar, advance_pair, wall_distance
 
-__all__ = ["KOmegaSST", "OversetSST", "freestream_turbulence"]
+__all__ = ["KOmegaSST", "OversetSST", "freestream_turbulence", "bilinear"]
 
 BETA_1 = 0.075
 
@@ -65,20 +65,29 @@ class KOmegaSST:
     first fluid point may lie in the log layer, the deck at full scale), "blended" (the same k and omega at
     the wall, but the velocity forced to Spalding's profile only as far as the eddy viscosity next to the wall
     reaches the law's, the linear no-slip profile where the layer is laminar: a laminar layer can then
-    separate at a corner, where the wall function lets it slip; docs/aero.md), "equilibrium" (the wall
+    separate at a corner, where the wall function lets it slip; docs/cfd.md), "equilibrium" (the wall
     function with the log layer's own k production, u_tau^3 / (kappa d), whatever the cell's k: the layer is
     turbulent wherever its first cell lies in the log layer, as a deck's at Re 1e8 is from its nose, where
     the wall function's production, which scales with sqrt(k), leaves it laminar) or "resolved" (k = 0 at the
     wall, for grids with the first point in the viscous sublayer). ``far_walls``: (polygon, pose) pairs of walls
     that are not bodies of this grid but count in its wall distance (an overset background: the body of
-    the body grid at its starting pose)."""
+    the body grid at its starting pose).
+
+    The model makes itself ``sim``'s turbulence model, which the simulation advances at the end of each of
+    its steps (bridge.cfd.flow); ``attach=False`` leaves it to a coupled model that advances it itself
+    (``OversetSST``)."""
 
     BODY_WALLS = ("function", "resolved", "blended", "equilibrium")
     _KERNEL_WALLS = {"resolved": 0, "function": 1, "blended": 1, "equilibrium": 2}   # sst_body_walls' ``function``
 
-    def __init__(self, sim, k_inf: float, omega_inf: float, body_walls: str = "function", far_walls=()):
+    name = "sst"
+
+    def __init__(self, sim, k_inf: float, omega_inf: float, body_walls: str = "function", far_walls=(),
+                 attach: bool = True):
         if not (k_inf >= 0 and omega_inf > 0):
             raise ValueError(f"k_inf >= 0 and omega_inf > 0 needed, got {k_inf}, {omega_inf}")
+        if attach and sim.turbulence.name != "laminar":
+            raise ValueError(f"this flow already has a turbulence model ({sim.turbulence.name}); a flow owns one")
         if body_walls not in self.BODY_WALLS:
             raise ValueError(f"body_walls: one of {', '.join(self.BODY_WALLS)}, got {body_walls!r}")
         self.sim = sim
@@ -121,6 +130,8 @@ class KOmegaSST:
         self.update()
         for name in self.state_arrays():   # saved and loaded with the flow (bridge.cfd.state)
             sim.state.register(name, lambda name=name: self.state_arrays()[name], after_load=self.restored)
+        if attach:   # the simulation owns the model and advances it in its step (bridge.cfd.flow)
+            sim.use_turbulence(self)
 
     def _box(self, body, pose) -> tuple[int, int, int, int]:
         """(i0, j0, ni, nj) in storage indices: the cells within the body's radius and 4 cells of its
@@ -193,7 +204,7 @@ class KOmegaSST:
         return 1.0 / total if total > 0 else float("inf")
 
     def advance(self, dt: float) -> None:
-        """k and omega over dt (call after the flow's step): the coefficients and the flow's nu + nu_t
+        """k and omega over dt (the flow calls it after its own step): the coefficients and the flow's nu + nu_t
         from the flow's new velocity and the k, omega at the step's start (one coefficient pass per
         step; the flow's next step sees nu_t lagged by that step, as in any segregated scheme)."""
         self.update()
@@ -232,7 +243,7 @@ class KOmegaSST:
         return self.sim.nu.numpy()[g:g + grid.ny, g:g + grid.nx] - self.nu
 
 
-def _bilinear(field: np.ndarray, xc: np.ndarray, yc: np.ndarray, px: np.ndarray, py: np.ndarray) -> np.ndarray:
+def bilinear(field: np.ndarray, xc: np.ndarray, yc: np.ndarray, px: np.ndarray, py: np.ndarray) -> np.ndarray:
     """Bilinear interpolation of a cell field (ny, nx) on the centres xc (uniform), yc (increasing) at the
     points (px, py), clamped to the lattice: second order, and it keeps k and omega positive."""
     dx = xc[1] - xc[0]
@@ -261,21 +272,23 @@ class OversetSST:
     (``TransportedScalar``: the grid's velocity). Holding is the walls' mechanism (``KOmegaSST.hold``), so
     positivity and the stage scheme are untouched; bilinear interpolation keeps the values positive."""
 
+    name = "sst"
+
     def __init__(self, pair, k_inf: float, omega_inf: float, body_walls: str = "function", ring: int = 2):
         self.pair = pair
         pose0 = pair.motion.pose(pair.t)
         polygons = [b.polygon for b in pair.body.bodies]
         self.background = KOmegaSST(pair.background, k_inf, omega_inf, body_walls,
-                                    far_walls=[(p, pose0) for p in polygons])
-        self.body = KOmegaSST(pair.body, k_inf, omega_inf, body_walls)
+                                    far_walls=[(p, pose0) for p in polygons], attach=False)
+        self.body = KOmegaSST(pair.body, k_inf, omega_inf, body_walls, attach=False)
         g, gb = GHOST, pair.body.grid
         j, i = np.meshgrid(np.arange(gb.ny), np.arange(gb.nx), indexing="ij")
         edge = (i < ring) | (i >= gb.nx - ring) | (j < ring) | (j >= gb.ny - ring)
-        self._ring = (j[edge] + g, i[edge] + g)
-        self._ring_xy = (gb.x_centres[i[edge]], gb.y_centres[j[edge]])
-        pair.model = self
+        self.ring_cells = (j[edge] + g, i[edge] + g)
+        self.ring_xy = (gb.x_centres[i[edge]], gb.y_centres[j[edge]])
+        pair.use_turbulence(self)   # the pair advances it at the end of its step (bridge.cfd.flow)
 
-    def _hole_cells(self, t: float):
+    def hole_cells(self, t: float):
         """Background cells (storage J, I) whose centres lie in the hole at t, and their body coordinates."""
         pair, g = self.pair, GHOST
         grid, gb = pair.background.grid, pair.body.grid
@@ -297,15 +310,15 @@ class OversetSST:
         bg, body = self.background, self.body
         gb = pair.body.grid
         bg.update()
-        (J, I), xi, eta = self._hole_cells(t)
+        (J, I), xi, eta = self.hole_cells(t)
         if J.size:
-            bg.hold(J, I, *(_bilinear(s.interior(), gb.x_centres, gb.y_centres, xi, eta)
+            bg.hold(J, I, *(bilinear(s.interior(), gb.x_centres, gb.y_centres, xi, eta)
                             for s in (body.k, body.omega)))
         advance_pair(bg.k, bg.omega, dt)
         body.update()
         grid = pair.background.grid
-        X, Y = pair.to_background(*self._ring_xy, t)
-        body.hold(*self._ring, *(_bilinear(s.interior(), grid.x_centres, grid.y_centres, X, Y)
+        X, Y = pair.to_background(*self.ring_xy, t)
+        body.hold(*self.ring_cells, *(bilinear(s.interior(), grid.x_centres, grid.y_centres, X, Y)
                                  for s in (bg.k, bg.omega)))
         advance_pair(body.k, body.omega, dt)
 

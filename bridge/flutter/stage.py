@@ -164,7 +164,7 @@ def _summary(d: FlutterStageResult, fopts: FlutterOptions) -> dict[str, float | 
         m = d.multimode
         s["flutter.multimode_critical_speed_m_s"] = _number(m.critical_speed_m_s) if m.flutter else None
         s["flutter.divergence_speed_m_s"] = _number(m.divergence_speed_m_s)
-        gaps = _pk_coverage(m)
+        gaps = pk_coverage(m)
         s["flutter.multimode_uncovered"] = "; ".join(gaps) if gaps else None
     s.update(_lateral_summary(d))
     return s
@@ -371,7 +371,7 @@ def _write_multimode(g: Any, mm: MultimodeResult, which: str) -> None:
                       "wind speeds of those points, one per unresolved_mode entry")
 
 
-def _pk_coverage(m: MultimodeResult) -> list[str]:
+def pk_coverage(m: MultimodeResult) -> list[str]:
     """'MODE a-b m/s[, c-d m/s]' for each p-k mode whose damping the aerodynamic data leave out at some of the
     speeds searched: the stretches where it was computed.  A single missing point between two computed ones
     is an unresolved point (reported apart), not a gap in the data."""
@@ -439,7 +439,7 @@ def _report(d: FlutterStageResult, source: str, fopts: FlutterOptions) -> str:
             f"first zero damping at V = {m.critical_speed_m_s:.2f} m/s in mode {m.unstable_mode} "
             f"(f = {m.frequency_hz_at_flutter:.4f} Hz)." if m.flutter
             else f"no damping ratio of an oscillating mode crosses zero below {m.max_speed_searched_m_s:g} m/s.")]
-        covered = _pk_coverage(m)
+        covered = pk_coverage(m)
         if covered:
             lines.append("Damping computed only where the aerodynamic data cover the mode's frequency (Omega inside "
                          "the table; elsewhere NaN, and a crossing there cannot be found): " + "; ".join(covered) + ".")

@@ -6,8 +6,8 @@ validation against Theodorsen and its status)."""
 import numpy as np
 import pytest
 
-from bridge.aero.forced_motion import QUALITY, ForcedCase, preset, run_case
-from bridge.aero.stage import _unit_polygon
+from bridge.aero.forced_motion import ForcedCase, run_case
+from bridge.aero.presets import QUALITY, preset, section_polygons
 from bridge.cfd.sections import Rectangle
 
 
@@ -23,13 +23,12 @@ def test_a_killed_case_resumes_from_its_checkpoint_and_ends_with_the_same_number
     function of the last two steps, which the hole extrapolates; SST: k, omega and the eddy viscosity
     of the next step, on each grid). Overset and SST ~20 s each (slow), the laminar single grid a few
     seconds."""
-    from dataclasses import replace
 
-    poly = _unit_polygon(Rectangle(10.0, 2.0))
+    poly = section_polygons(Rectangle(10.0, 2.0))[0]
     case = ForcedCase("heave", (2.5,), (0.005,))
     q = preset("tiny", grid.removesuffix("-sst"))
     if grid.endswith("-sst"):
-        q = replace(q, turbulence="sst", reynolds=1e7)
+        q = q.with_(turbulence="sst", reynolds=1e7)
     whole = run_case(poly, case, q)
     ckpt = tmp_path / "case.h5"
     calls = []
@@ -110,13 +109,13 @@ def test_the_aero_stage_feeds_flutter_and_bridges_with_one_deck_share_it(tmp_pat
 
 def test_a_checkpoint_of_other_solver_code_is_not_resumed(monkeypatch):
     """The checkpoint's key holds the source of the solver: a changed CFD never continues an old run."""
-    from bridge import cache
+    from bridge.aero import forced_motion
     from bridge.aero.forced_motion import case_key
 
-    poly = _unit_polygon(Rectangle(10.0, 2.0))
+    poly = section_polygons(Rectangle(10.0, 2.0))[0]
     case = ForcedCase("heave", (2.5,), (0.005,))
     before = case_key(poly, case, QUALITY["tiny"])
-    monkeypatch.setattr(cache, "_code_digest", lambda modules: "edited")
+    monkeypatch.setattr(forced_motion, "code_digest", lambda modules: "edited")
     assert case_key(poly, case, QUALITY["tiny"]) != before
     # and it covers every kernel module the CFD runs (the SST's kernels.transport once was not), as does
     # the aero stage's cache key
@@ -127,7 +126,7 @@ def test_a_checkpoint_of_other_solver_code_is_not_resumed(monkeypatch):
     from bridge.stages import STAGES
 
     seen = []
-    monkeypatch.setattr(cache, "_code_digest", lambda modules: seen.extend(modules) or "x")
+    monkeypatch.setattr(forced_motion, "code_digest", lambda modules: seen.extend(modules) or "x")
     case_key(poly, case, QUALITY["tiny"])
     used = [m for m in sys.modules if m.startswith("kernels.") and m != "kernels.fem"]
     assert "kernels.transport" in used and "kernels.wall_law" in used
@@ -142,7 +141,7 @@ def test_the_grid_option_is_checked_and_picks_the_overset_pair():
 
     with pytest.raises(InputError, match="aero.grid.*single, overset"):
         AeroOptions(grid="chimera")
-    assert preset("quick", "overset").overset and not preset("quick").overset
+    assert preset("quick", "overset").grid.overset and not preset("quick").grid.overset
     with pytest.raises(InputError, match="aero.grid"):
         preset("quick", "chimera")
 
@@ -158,7 +157,7 @@ def test_the_sst_walls_option_is_checked_reaches_the_preset_and_the_stage_key():
     with pytest.raises(InputError, match="aero.sst_walls.*equilibrium, function, blended"):
         AeroOptions(sst_walls="log")
     with pytest.raises(InputError, match="aero.sst_walls"):
-        dc_replace(preset("quick", "overset"), sst_walls="log")
+        preset("quick", "overset").with_(sst_walls="log")
     sc = load_scenario("great_belt")
     keys = {stage_key("aero", dc_replace(sc, aero=AeroOptions(sst_walls=walls)), {}, False)
             for walls in ("function", "blended", "equilibrium")}
@@ -166,9 +165,9 @@ def test_the_sst_walls_option_is_checked_reaches_the_preset_and_the_stage_key():
     from bridge.aero.stage import preset_warnings
     from bridge.cfd.sections import great_belt_section
 
-    sst = dc_replace(preset("quick", "overset"), turbulence="sst", reynolds=1e8)
+    sst = preset("quick", "overset").with_(turbulence="sst", reynolds=1e8)
     assert preset_warnings(sst, "quick", great_belt_section()) == ""
-    blended = preset_warnings(dc_replace(sst, sst_walls="blended"), "quick", great_belt_section())
+    blended = preset_warnings(sst.with_(sst_walls="blended"), "quick", great_belt_section())
     assert "under study" in blended and "lift slope negative" in blended
 
 
@@ -177,13 +176,12 @@ def test_cases_side_by_side_give_the_numbers_of_cases_one_after_the_other(tmp_pa
     records bit for bit as the cases run one after the other here, and passes their progress lines on;
     the errors a worker raises cross the process boundary intact (they are picklable)."""
     import pickle
-    from dataclasses import replace
 
     from bridge.aero.forced_motion import StaticCase, run_cases
     from bridge.errors import ConvergenceError, DivergedError, InputError
 
-    poly = _unit_polygon(Rectangle(10.0, 2.0))
-    q = replace(QUALITY["tiny"], static_duration=1.0)
+    poly = section_polygons(Rectangle(10.0, 2.0))[0]
+    q = QUALITY["tiny"].with_(static_duration=1.0)
     jobs = [(StaticCase(a), None, f"angle {a:g}") for a in (2.0, -1.0, 0.0)]
     lines = []
     apart = run_cases(poly, jobs, q, workers=2, progress=lines.append)
@@ -200,14 +198,14 @@ def test_cases_side_by_side_give_the_numbers_of_cases_one_after_the_other(tmp_pa
 
 
 def test_a_multi_frequency_run_that_answers_nonlinearly_is_flagged():
-    """The stage's check of a multi-frequency run (bridge.aero.stage._check_distortion): a moment linear in the
+    """The stage's check of a multi-frequency run (bridge.aero.stage.check_distortion): a moment linear in the
     pitch passes; one with a quadratic part that would give the lowest sine alone a second harmonic of 10 % (the
     Great Belt deck's single-frequency pitch runs carried 8-11 % at the thesis's amplitudes, docs/aero.md) is
     flagged with its share, on the terminal and in the stage's warning."""
     from types import SimpleNamespace
 
     from bridge.aero.forced_motion import ForcedCase
-    from bridge.aero.stage import DISTORTION_LIMIT, _check_distortion
+    from bridge.aero.stage import DISTORTION_LIMIT, check_distortion
     from bridge.stages import RunOptions
 
     case = ForcedCase.multi_frequency("pitch", (0.25, 0.5, 0.75), 0.0174)
@@ -218,7 +216,7 @@ def test_a_multi_frequency_run_that_answers_nonlinearly_is_flagged():
     sel = t >= 2 * 2 * np.pi / 0.25
     for eps, flagged in ((0.0, False), (0.2 / case.amplitudes[0], True)):   # eps a_1^2 / 2 = 0.1 a_1
         rec = SimpleNamespace(t=t, lift=5.0 * x + eps * 5.0 * x**2, moment=1.2 * x + eps * 1.2 * x**2)
-        warning = _check_distortion(rec, sel, case, "", options)
+        warning = check_distortion(rec, sel, case, "", options)
         assert bool(warning) == flagged, (eps, warning)
     assert "multi-frequency pitch run" in warning and "excitation = \"single\"" in warning
     assert len(said) == 1 and said[0].startswith("aero: WARNING")

@@ -91,12 +91,13 @@ def test_the_forced_motion_window_holds_every_period_after_the_discarded_ones():
     """Regression: the mask started after the first sample of the window and ended before the run's last
     one, so the fit often lost a period (the standard preset fitted 1 of its 2).  Records end as run_case
     ends them: at the first step at or past the end time; 100 of them with random uneven steps."""
-    from bridge.aero.forced_motion import QUALITY, ForcedCase, ForceRecord, whole_periods
+    from bridge.aero.forced_motion import ForcedCase, ForceRecord, whole_periods
+    from bridge.aero.presets import QUALITY
 
     for name in ("standard", "tiny"):
         q = QUALITY[name]
         case = ForcedCase.thesis("pitch", 0.785)
-        fitted = q.periods - q.discard_periods
+        fitted = q.run.periods - q.run.discard_periods
         for seed in range(100):
             t = np.cumsum(np.random.default_rng(seed).uniform(0.005, 0.015, 8000))
             t = t[: int(np.searchsorted(t, case.end_time(q))) + 1]

@@ -1,26 +1,25 @@
 """A multi-frequency run (a sum of sines) identifies the same FRFs as single-frequency runs (issue: within
 3 %), and the options that ask for one are checked."""
 
-import dataclasses
 
 import numpy as np
 import pytest
 
-from bridge.aero.forced_motion import QUALITY, THESIS_HEAVE_RATE, THESIS_PITCH_RATE, ForcedCase, run_case, whole_periods
+from bridge.aero.forced_motion import THESIS_HEAVE_RATE, THESIS_PITCH_RATE, ForcedCase, run_case, whole_periods
 from bridge.aero.frequency_response import forced_motion_response
 from bridge.aero.options import AeroOptions
-from bridge.aero.stage import _unit_polygon
+from bridge.aero.presets import QUALITY, section_polygons
 from bridge.cfd.sections import FlatPlate
 from bridge.errors import InputError
 
 # 4 % plate, 24 cells per chord, dy = dx / 4 (4 cells thick), 4 chords of wake: coarse, but a resolved body
-COARSE = dataclasses.replace(QUALITY["tiny"], name="coarse", cells_per_chord=24, dy_over_dx=0.25, upstream=1.0,
+COARSE = QUALITY["tiny"].with_(name="coarse", cells_per_chord=24, dy_over_dx=0.25, upstream=1.0,
                              downstream=4.0, half_height=1.5, core_half_height=0.1, reynolds=1000.0, periods=4,
                              discard_periods=2, settle_time=16.0)
 
 
 def _frfs(case, q):
-    rec = run_case(_unit_polygon(FlatPlate(1.0, 0.04)), case, q)
+    rec = run_case(section_polygons(FlatPlate(1.0, 0.04))[0], case, q)
     sel = whole_periods(rec, case, q)
     out = forced_motion_response(rec.t[sel], rec.motion[sel], list(case.reduced_frequencies), dof=case.dof,
                                  speed_m_s=1.0, deck_width_m=1.0, air_density_kg_m3=1.0, lift=rec.lift[sel],
@@ -38,7 +37,7 @@ def test_a_multi_frequency_run_agrees_with_single_frequency_runs(grid, tolerance
     FRFs wrong by their own size if broken: 20 %; measured 1.5-7.7 % (h_mu at K = 1.571: 17 %, its small
     real part), because the moving immersed boundary's error depends on the path the body takes through
     the cells (docs/aero.md, multi-frequency)."""
-    q = dataclasses.replace(COARSE, overset=grid == "overset")
+    q = COARSE.with_(overset=grid == "overset")
     Ks = (2 * np.pi / 8, 2 * np.pi / 4)
     for dof, rate in (("heave", THESIS_HEAVE_RATE), ("pitch", THESIS_PITCH_RATE)):
         multi = _frfs(ForcedCase.multi_frequency(dof, Ks, rate), q)

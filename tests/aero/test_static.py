@@ -11,9 +11,9 @@ import math
 import numpy as np
 import pytest
 
-from bridge.aero.forced_motion import QUALITY, ForceRecord, StaticCase, run_case
+from bridge.aero.forced_motion import ForceRecord, StaticCase, run_case
 from bridge.aero.options import AeroOptions
-from bridge.aero.stage import _unit_polygon
+from bridge.aero.presets import QUALITY, section_polygons
 from bridge.aero.static import (
     chordwise_loading,
     shedding_frequency,
@@ -77,7 +77,7 @@ def test_static_angles_are_checked():
 
 
 # a coarse but resolving grid for a 4 % plate: 24 cells per chord, dy = dx / 4 (the plate 4 cells thick)
-COARSE = dataclasses.replace(QUALITY["tiny"], name="coarse", cells_per_chord=24, dy_over_dx=0.25, upstream=1.0,
+COARSE = QUALITY["tiny"].with_(name="coarse", cells_per_chord=24, dy_over_dx=0.25, upstream=1.0,
                              downstream=4.0, half_height=1.5, core_half_height=0.1, reynolds=1000.0,
                              static_duration=12.0)
 
@@ -88,7 +88,7 @@ def test_a_thin_plate_held_still_has_thin_aerofoil_slopes_and_symmetry():
     even in the angle (the grid is symmetric), dC_L/dalpha within 20 % of 2 pi (viscosity, the finite
     wake, the short run and Wagner's lag all lower it) and the aerodynamic centre near the quarter chord:
     dC_M/dalpha (about mid-chord) over dC_L/dalpha within 0.25 +- 0.05."""
-    poly = _unit_polygon(FlatPlate(1.0, 0.04))
+    poly = section_polygons(FlatPlate(1.0, 0.04))[0]
     angles = (-2.0, 0.0, 2.0)
     recs = [run_case(poly, StaticCase(a, grid_angle_deg=2.0), COARSE) for a in angles]
     st = static_coefficients(recs, angles, 0.04)
@@ -108,7 +108,7 @@ def test_the_static_group_report_and_lateral_model(tmp_path):
     CFD table without static runs)."""
     import h5py
 
-    from bridge.aero.stage import _static_report, _write_static_h5
+    from bridge.aero.stage import static_report, write_static_h5
     from bridge.flutter.aerodynamics import Theodorsen, WithLateral
     from bridge.flutter.options import FlutterOptions
 
@@ -118,7 +118,7 @@ def test_the_static_group_report_and_lateral_model(tmp_path):
                             (-2.0, 0.0, 2.0), 0.1),
         lift_rms=np.array([0.0, 0.0, 0.05]))
     with h5py.File(tmp_path / "r.h5", "w") as h5:
-        _write_static_h5(h5.create_group("static"), st)
+        write_static_h5(h5.create_group("static"), st)
     with h5py.File(tmp_path / "r.h5", "r") as h5:
         g = h5["static"]
         names = []
@@ -130,7 +130,7 @@ def test_the_static_group_report_and_lateral_model(tmp_path):
             assert g[n].attrs["unit"] is not None and g[n].attrs["description"], n
         assert g["fit/lift_slope"][()] == pytest.approx(0.2 / np.radians(2.0))   # C_L = 2 x the CFD lift
         assert g.attrs["depth_over_chord"] == 0.1
-    text = "\n".join(_static_report(st))
+    text = "\n".join(static_report(st))
     assert "| steady |" in text and "unresolved" in text
     static_qs = st.quasi_steady()
     cfd = WithLateral(Theodorsen(), static_qs)
@@ -174,7 +174,7 @@ def test_the_thin_plates_loading_integrates_to_thin_aerofoil_theory():
 
 
 def test_run_case_shows_the_flow_to_an_observer_after_every_step():
-    q = dataclasses.replace(QUALITY["tiny"], static_duration=1.0)
+    q = QUALITY["tiny"].with_(static_duration=1.0)
     seen = []
-    rec = run_case(_unit_polygon(FlatPlate(1.0, 0.1)), StaticCase(2.0), q, observe=lambda flow: seen.append(flow.t))
+    rec = run_case(section_polygons(FlatPlate(1.0, 0.1)), StaticCase(2.0), q, observe=lambda flow: seen.append(flow.t))
     assert len(seen) == rec.steps and seen == pytest.approx(list(rec.t))

@@ -237,7 +237,7 @@ def test_forced_faces_leave_no_cell_without_a_free_face_divergent(monkeypatch, c
     from bridge.cfd.immersed import ImmersedBody
 
     if not closed:
-        monkeypatch.setattr(ImmersedBody, "_close_targets", lambda self: None)
+        monkeypatch.setattr(ImmersedBody, "close_targets", lambda self: None)
     sim = _channel(Stationary(2.0, 0.1)) if case.startswith("still") else _pitching_deck_on_stretched_grid()
     run(sim, 0.3, [])
     body = sim.bodies[0]
@@ -300,7 +300,7 @@ def test_heaving_body_force_without_step_to_step_noise(monkeypatch, closed):
     from bridge.cfd.immersed import ImmersedBody
 
     if not closed:
-        monkeypatch.setattr(ImmersedBody, "_close_targets", lambda self: None)
+        monkeypatch.setattr(ImmersedBody, "close_targets", lambda self: None)
     sim = _channel(HarmonicMotion(2.5, 0.0, (0.0, 0.1, 0.0), np.pi))
     h = ForceHistory()
     run(sim, 6.0, [h])

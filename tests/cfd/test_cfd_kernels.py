@@ -177,7 +177,7 @@ def test_recorded_launches_update_scalars_and_keep_row_chunks_apart():
     # NumPy integer row offsets are keyed by value too: one record per chunk, not one shared record
     launcher.forget()
     launcher.rows(_scaled_rows, 8, np.int64(0), [q, 4.0, ROW0], min_split=2)
-    assert len(launcher._records) == 2
+    assert launcher.n_records == 2
     np.testing.assert_array_equal(q.numpy(), 4.0 * expected_rows)
     # more threads than rows: the empty chunks are skipped, not recorded
     RowLauncher("cpu", 3).rows(_scaled_rows, 2, 0, [q, 5.0, ROW0], min_split=1)

@@ -1,8 +1,7 @@
 """tools/deck_layer.py: the Great Belt deck's boundary layer over its top.  Bad input stops it before any run;
 the geometry and the law-of-the-wall eddy viscosity it compares with have closed forms; a short run reads the
 first free cells above the top; and (slow) at the deck's Reynolds number the equilibrium wall's layer is
-turbulent from the nose where the wall function's is laminar (docs/aero.md, "A layer turbulent from the
-nose")."""
+turbulent from the nose where the wall function's is laminar (docs/cfd.md, "Turbulence model and walls")."""
 
 import json
 import math

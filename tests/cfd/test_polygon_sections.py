@@ -329,11 +329,11 @@ def test_the_shipped_example_outline():
 
 def test_an_asymmetric_deck_with_a_wind_screen_runs_through_the_cfd():
     """One short forced heave on the 'tiny' preset (a few seconds): the forces are finite."""
-    from bridge.aero.forced_motion import ForcedCase, preset, run_case
-    from bridge.aero.stage import _unit_polygons
+    from bridge.aero.forced_motion import ForcedCase, run_case
+    from bridge.aero.presets import preset, section_polygons
 
     section = PolygonSection(outline_path=str(EXAMPLE))
-    polys = _unit_polygons(section)
+    polys = section_polygons(section)
     assert len(polys) == 2 and np.ptp(np.vstack([p.vertices for p in polys])[:, 0]) == pytest.approx(1.0)
     rec = run_case(polys, ForcedCase("heave", (2.5,), (0.005,)), preset("tiny"))
     assert rec.steps > 10

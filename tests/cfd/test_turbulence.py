@@ -11,7 +11,7 @@ import pytest
 from bridge.cfd import BoundaryConditions, CartesianGrid, FlowConfig, HarmonicMotion, Simulation
 from bridge.cfd.grids import GHOST
 from bridge.cfd.overset import OversetPair
-from bridge.cfd.turbulence import KOmegaSST, OversetSST, _bilinear, freestream_turbulence
+from bridge.cfd.turbulence import KOmegaSST, OversetSST, bilinear, freestream_turbulence
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "tools"))
 
@@ -115,11 +115,10 @@ def test_turbulence_crosses_a_moving_body_grid_as_it_crosses_one_grid():
     ref_model.k.set(_blob(*np.meshgrid(BACKGROUND.x_centres, BACKGROUND.y_centres)))
     for _ in range(150):
         pair.step(0.02)
-        ref.step(0.02)
-        ref_model.advance(0.02)
+        ref.step(0.02)   # and its SST model
     k_ref = ref_model.k.interior()
     X, Y = pair.to_background(*np.meshgrid(BODY_GRID.x_centres, BODY_GRID.y_centres), pair.t)
-    on_body = _bilinear(k_ref, BACKGROUND.x_centres, BACKGROUND.y_centres, X, Y)
+    on_body = bilinear(k_ref, BACKGROUND.x_centres, BACKGROUND.y_centres, X, Y)
     assert model.body.k.interior().max() > 2.0 * K0          # the blob is in the body grid now
     assert np.abs(model.body.k.interior() - on_body).max() < 0.05 * 4 * K0
     assert np.abs(model.background.k.interior() - k_ref).max() < 0.06 * 4 * K0
@@ -133,16 +132,16 @@ def test_the_overset_grids_hold_each_others_k_and_omega():
         pair.step(0.02)
     body_old = [s.interior() for s in (model.body.k, model.body.omega)]
     pair.step(0.02)
-    (J, I), xi, eta = model._hole_cells(pair.t)
+    (J, I), xi, eta = model.hole_cells(pair.t)
     assert J.size > 20
     for scalar, old in zip((model.background.k, model.background.omega), body_old, strict=True):
-        want = _bilinear(old, BODY_GRID.x_centres, BODY_GRID.y_centres, xi, eta)
+        want = bilinear(old, BODY_GRID.x_centres, BODY_GRID.y_centres, xi, eta)
         assert np.allclose(scalar.q.numpy()[J, I], want, rtol=1e-12, atol=0)
-    X, Y = pair.to_background(*model._ring_xy, pair.t)
+    X, Y = pair.to_background(*model.ring_xy, pair.t)
     for body_s, bg_s in ((model.body.k, model.background.k), (model.body.omega, model.background.omega)):
-        want = _bilinear(bg_s.interior(), BACKGROUND.x_centres, BACKGROUND.y_centres, X, Y)
-        assert np.allclose(body_s.q.numpy()[model._ring], want, rtol=1e-12, atol=0)
-    assert model.body.k.q.numpy()[model._ring].max() > 1.5 * K0   # the blob is at the ring: not trivially uniform
+        want = bilinear(bg_s.interior(), BACKGROUND.x_centres, BACKGROUND.y_centres, X, Y)
+        assert np.allclose(body_s.q.numpy()[model.ring_cells], want, rtol=1e-12, atol=0)
+    assert model.body.k.q.numpy()[model.ring_cells].max() > 1.5 * K0   # the blob is at the ring: not trivially uniform
 
 
 def test_an_overset_body_has_its_walls_in_both_grids_and_the_hole_is_the_cells_inside_it():
@@ -167,7 +166,7 @@ def test_an_overset_body_has_its_walls_in_both_grids_and_the_hole_is_the_cells_i
         for s in (m.k, m.omega):
             q = s.interior()
             assert np.all(np.isfinite(q)) and q.min() > 0
-    (J, I), _, _ = model._hole_cells(pair.t)
+    (J, I), _, _ = model.hole_cells(pair.t)
     X, Y = np.meshgrid(BACKGROUND.x_centres, BACKGROUND.y_centres)
     xi, eta = pair.to_body(X, Y, pair.t)
     hx0, hx1, hy0, hy1 = pair.hole
@@ -240,16 +239,13 @@ def test_the_great_belt_deck_at_80_cells_per_chord_stays_bounded_with_the_wall_f
     by t = 0.5 B/V and the run diverged; with the wall law only on lines that meet the wall nearly square
     (kernels.cfd.square_to_wall) the speed stays below 1.8 U over the start (measured 1.51 U up to t = 1, with the
     presets' equilibrium wall as with the wall function's own k production, 1.507 and 1.510)."""
-    from dataclasses import replace
-
-    from bridge.aero.forced_motion import QUICK_UNTIL_2026_12_02, StaticCase, _overset_flow
-    from bridge.aero.stage import _unit_polygons
+    from bridge.aero.forced_motion import StaticCase
+    from bridge.aero.presets import SHORT_DOMAIN_40, build_flow, section_polygons
     from bridge.cfd.sections import great_belt_section
 
     # the domain of the run that diverged (2 chords upstream, 10 down, 2 to each side)
-    q = replace(QUICK_UNTIL_2026_12_02, overset=True, turbulence="sst", reynolds=50 * 31 / 1.48e-5,
-                cells_per_chord=80)
-    flow = _overset_flow(q, _unit_polygons(great_belt_section()), StaticCase(0.0), None)
+    q = SHORT_DOMAIN_40.with_(overset=True, turbulence="sst", reynolds=50 * 31 / 1.48e-5, cells_per_chord=80)
+    flow = build_flow(q, section_polygons(great_belt_section()), StaticCase(0.0))
     peak = 0.0
     while flow.t < 1.0:
         flow.step(flow.stable_dt())
@@ -276,9 +272,8 @@ def test_the_flow_state_saved_to_hdf5_and_loaded_continues_bit_for_bit(tmp_path)
 
     def steps(sim, model, n):
         for _ in range(n):
-            dt = min(sim.stable_dt(), model.stable_dt())
-            sim.step(dt)
-            model.advance(dt)
+            dt = sim.stable_dt()   # the flow's limit and its model's
+            sim.step(dt)   # and its SST model
 
     sim, model = build()
     steps(sim, model, 15)

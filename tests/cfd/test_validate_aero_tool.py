@@ -4,7 +4,7 @@ fields asked for, and a value outside the preset's range stops the tool before a
 import pytest
 from cfd_helpers import load_tool
 
-from bridge.aero.forced_motion import preset
+from bridge.aero.presets import preset
 from bridge.errors import InputError
 
 
@@ -13,8 +13,9 @@ def test_grid_overrides_replace_only_the_fields_given():
     q = va.plate_quality("standard", "overset", reynolds=1e4,
                          grid_overrides={"cells_per_chord": 200, "dy_over_dx": 0.5, "background_coarsening": 4})
     base = preset("standard", "overset")
-    assert (q.cells_per_chord, q.dy_over_dx, q.background_coarsening, q.reynolds) == (200, 0.5, 4, 1e4)
-    assert (q.upstream, q.downstream, q.periods, q.cfl) == (base.upstream, base.downstream, base.periods, base.cfl)
+    g = q.grid
+    assert (g.cells_per_chord, g.dy_over_dx, g.background_coarsening, q.physics.reynolds) == (200, 0.5, 4, 1e4)
+    assert (g.upstream, g.downstream, q.run) == (base.grid.upstream, base.grid.downstream, base.run)
     assert va.plate_quality("standard", "overset", grid_overrides={"cells_per_chord": None}) == base
     with pytest.raises(ValueError, match="not among"):
         va.plate_quality("standard", "overset", grid_overrides={"upstream": 8.0})

@@ -176,7 +176,7 @@ def test_a_pair_without_a_root_in_the_table_does_not_stop_the_stage(tmp_path):
 
 def test_pk_coverage_lists_the_stretches_with_data_and_skips_single_unresolved_points():
     from bridge.flutter.multimode import MultimodeResult
-    from bridge.flutter.stage import _pk_coverage
+    from bridge.flutter.stage import pk_coverage
 
     v = np.linspace(10.0, 100.0, 10)
     z = np.full((10, 4), 0.01)
@@ -186,7 +186,7 @@ def test_pk_coverage_lists_the_stretches_with_data_and_skips_single_unresolved_p
     m = MultimodeResult(labels=("A", "B", "C", "D"), speed_m_s=v, frequency_hz=np.where(np.isnan(z), np.nan, 0.2),
                         damping_ratio=z, flutter=False, critical_speed_m_s=np.nan, frequency_hz_at_flutter=np.nan,
                         reduced_frequency=np.nan, unstable_mode="", max_speed_searched_m_s=100.0)
-    assert _pk_coverage(m) == ["B 40.0-100.0 m/s", "D 10.0-40.0 m/s, 70.0-100.0 m/s"]
+    assert pk_coverage(m) == ["B 40.0-100.0 m/s", "D 10.0-40.0 m/s, 70.0-100.0 m/s"]
 
 
 # ------------------------------------------------------------------------------ columns

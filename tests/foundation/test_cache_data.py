@@ -381,7 +381,7 @@ SYSTEM = {"command": "touch /tmp/pwned-by-cache"}
     ({"$": "object", "type": "bridge.flutter.tables:DerivativeTable.__init__.__globals__", "arguments": {}}, None,
      "not a class defined there"),
     ({"$": "dataclass", "type": "bridge.nowhere:X", "fields": {}}, None, "no module"),
-    ({"$": "dataclass", "type": "bridge.config:_Table", "fields": {}}, None, "is not a dataclass"),
+    ({"$": "dataclass", "type": "bridge.toml_table:Table", "fields": {}}, None, "is not a dataclass"),
     ({"$": "object", "type": "bridge.cache:StoredGroup", "arguments": {"image": ""}}, None, "does not rebuild"),
     ({"$": "object", "type": "bridge.flutter.derivatives:FRF", "arguments": {}}, None, "does not rebuild"),
     ({"$": "namedtuple", "type": "bridge.stages:RunOptions", "fields": {}}, None, "is not a NamedTuple"),

@@ -215,7 +215,8 @@ def test_a_one_value_list_is_answered_about_the_value(key, values, named):
 
 
 def test_progress_gives_the_whole_runs_time_left():
-    from bridge.aero.forced_motion import ForcedCase, RunProgress, preset
+    from bridge.aero.forced_motion import ForcedCase, RunProgress
+    from bridge.aero.presets import preset
 
     q = preset("tiny")
     cases = [ForcedCase.thesis("heave", 0.5), ForcedCase.thesis("pitch", 0.5), ForcedCase.thesis("heave", 1.0)]

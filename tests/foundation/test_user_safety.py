@@ -486,7 +486,8 @@ def test_readme_commands_and_option_names_match_the_code():
         assert f"`{model}`" in readme, model
     from bridge import scenario, sweep
 
-    known = {o for parser in (scenario._parser(), sweep._parser()) for a in parser._actions for o in a.option_strings}
+    parsers = (scenario.build_parser(), sweep.build_parser())
+    known = {o for parser in parsers for a in parser._actions for o in a.option_strings}
     for flag in set(re.findall(r"(?<![\w-])--[a-z][a-z-]+", readme)):
         assert flag in known, f"README names an option the commands do not have: {flag}"
 

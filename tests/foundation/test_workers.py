@@ -76,7 +76,8 @@ def wait_for(lines: list[str], text: str, proc: subprocess.Popen, timeout: float
 # parent is killed; "running" is printed once both workers have sent a progress line.
 TWO_CASES = """
 import sys
-from bridge.aero.forced_motion import ForcedCase, preset, run_cases
+from bridge.aero.forced_motion import ForcedCase, run_cases
+from bridge.aero.presets import preset
 from bridge.cfd.sections import FlatPlate
 
 def main():
