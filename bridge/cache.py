@@ -75,7 +75,7 @@ def stage_key(name: str, scenario: Any, upstream_keys: Mapping[str, str], quick:
               for k, v in scenario_fields(scenario, include_none=True).items()
               if (top := k.split(".")[0].split("[")[0]) not in skip and (stage.uses is None or top in stage.uses)}
     files = {}
-    base = Path(scenario.source_path).parent if getattr(scenario, "source_path", None) else Path.cwd()
+    base = Path(scenario.source_path).parent if scenario.source_path else Path.cwd()
     for k, v in inputs.items():
         if k.endswith("_path") and isinstance(v, str):
             p = Path(v) if Path(v).is_absolute() else base / v

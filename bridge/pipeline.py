@@ -27,7 +27,7 @@ _KIND_STAGES = {"suspension_bridge": ("cable", "fem", "aero", "flutter"), "secti
 
 def wants_cfd(scenario: Scenario) -> bool:
     """True when the flutter stage is to use the deck's own aerodynamics (``[flutter] aerodynamics = "cfd"``)."""
-    fl, section = getattr(scenario, "flutter", None), getattr(scenario, "section", None)
+    fl, section = scenario.flutter, scenario.section
     return "cfd" in (getattr(fl, "aerodynamics", None), getattr(section, "aerodynamics", None))
 
 

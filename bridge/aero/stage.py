@@ -76,12 +76,12 @@ class AeroResult:
 def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
     from bridge.cfd.sections import great_belt_section
 
-    section = getattr(scenario, "deck_section", None) or great_belt_section()
-    aopts: AeroOptions = getattr(scenario, "aero", None) or AeroOptions()
+    section = scenario.deck_section or great_belt_section()
+    aopts: AeroOptions = scenario.aero or AeroOptions()
     quality = options.quality or ("tiny" if options.quick else aopts.quality)
     q = preset(quality, aopts.grid)
     if aopts.turbulence != "laminar":   # the deck's own Reynolds number, with the SST model
-        air = getattr(scenario, "air", None)
+        air = scenario.air
         nu_air = air.kinematic_viscosity_m2_s if air is not None else 1.48e-5
         q = q.with_(turbulence=aopts.turbulence, reynolds=aopts.wind_speed_m_s * section.chord_m / nu_air,
                     sst_walls=aopts.sst_walls)

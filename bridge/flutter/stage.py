@@ -85,17 +85,17 @@ def _lateral_effect(modal: ModalModel, aero: Any, rho: float, gov: FlutterResult
 def _modes(scenario: Any, upstream: dict) -> tuple[ModalModel, str]:
     if "fem" in upstream:
         return upstream["fem"].data.modal_model, "fem stage"
-    if getattr(scenario, "kind", None) == "section" and getattr(scenario, "section", None) is not None:
+    if scenario.kind == "section" and scenario.section is not None:
         return scenario.section.modal_model(), "sectional model"
-    if getattr(scenario, "modal", None) is not None:
+    if scenario.modal is not None:
         return scenario.modal, "[modal] table"
     raise InputError("flutter", None, "needs modes: run the fem stage or give [modal] data")
 
 
 def _air_density(scenario: Any, fopts: FlutterOptions) -> float:
-    section = getattr(scenario, "section", None) if getattr(scenario, "kind", None) == "section" else None
+    section = scenario.section if scenario.kind == "section" else None
     for value in (getattr(section, "air_density_kg_m3", None), fopts.air_density_kg_m3,
-                  getattr(getattr(scenario, "air", None), "density_kg_m3", None)):
+                  scenario.air.density_kg_m3):
         if value is not None:
             return float(value)
     return 1.225
@@ -104,11 +104,11 @@ def _air_density(scenario: Any, fopts: FlutterOptions) -> float:
 def options_and_aerodynamics(scenario: Any, upstream: dict) -> tuple[FlutterOptions, Any]:
     """The scenario's flutter options (a [section]'s aerodynamics taking the place of [flutter]'s) and the
     aerodynamic model they name (tables read from the scenario's folder; the aero stage's in ``upstream``)."""
-    fopts: FlutterOptions = getattr(scenario, "flutter", None) or FlutterOptions()
-    section = getattr(scenario, "section", None) if getattr(scenario, "kind", None) == "section" else None
+    fopts: FlutterOptions = scenario.flutter or FlutterOptions()
+    section = scenario.section if scenario.kind == "section" else None
     if section is not None and section.aerodynamics is not None:
         fopts = replace(fopts, aerodynamics=section.aerodynamics)
-    src = getattr(scenario, "source_path", None)
+    src = scenario.source_path
     cfd = upstream["aero"].data.model if "aero" in upstream else None
     return fopts, fopts.aerodynamic_model(Path(src).parent if src else None, cfd=cfd)
 
