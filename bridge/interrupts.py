@@ -59,18 +59,30 @@ def exit_command(status: int) -> None:
 
 @contextlib.contextmanager
 def sigint_held():
-    """SIGINT blocked in the calling thread for the block: a Ctrl-C that lands meanwhile waits and is
-    delivered (to the usual handler) when the block ends.  For the steps that must not be cut in half (a
-    result folder renamed into place) and for starting worker processes, which inherit the blocked signal
-    (:mod:`bridge.workers`).  A no-op where the platform cannot block signals."""
-    if not hasattr(signal, "pthread_sigmask"):
-        yield
-        return
-    before = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    """Ctrl-C held back for the block: one that lands meanwhile is delivered (to the usual handler) when the
+    block ends.  For the steps that must not be cut in half (a result folder renamed into place, a worker
+    process started and handed its start-up data) and for starting worker processes, which inherit the
+    blocked signal (:mod:`bridge.workers`).
+
+    Two things are needed.  Blocking SIGINT in the calling thread is what a child started here inherits.  But
+    the signal may reach the process through another thread (a pool's manager thread, a queue's feeder), whose
+    C handler only flags it for the main thread's Python handler, which runs at the next bytecode whatever
+    this thread's mask: so in the main thread the Python handler is also swapped for one that only notes the
+    signal, and the noted one is raised again when the block ends."""
+    main = threading.current_thread() is threading.main_thread() and signal.getsignal(signal.SIGINT) is not None
+    noted: list[int] = []
+    old_handler = signal.signal(signal.SIGINT, lambda signum, frame: noted.append(signum)) if main else None
+    masked = hasattr(signal, "pthread_sigmask")
+    before = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT}) if masked else None
     try:
         yield
     finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, before)
+        if masked:
+            signal.pthread_sigmask(signal.SIG_SETMASK, before)   # a signal pending on this thread lands now
+        if main:
+            signal.signal(signal.SIGINT, old_handler)
+            if noted:
+                signal.raise_signal(signal.SIGINT)
 
 
 class Interrupts:

@@ -140,3 +140,31 @@ def test_an_interrupted_cfd_chain_leaves_no_worker(tmp_path, signum, after, grou
     finally:
         for pid in processes_with(token):
             os.kill(pid, signal.SIGKILL)
+
+
+def test_ctrl_c_reaching_another_thread_still_waits_for_a_held_block():
+    """bridge.interrupts.sigint_held: a SIGINT that the kernel hands to another thread (a pool's manager or a
+    queue's feeder thread) still only flags it for the main thread's Python handler, which used to raise
+    KeyboardInterrupt inside the held block whatever the main thread's mask: a worker started there was left
+    without its start-up data and printed "EOFError: Ran out of input" (seen in the slow interrupt test)."""
+    from bridge.interrupts import sigint_held
+
+    go, sent = threading.Event(), threading.Event()
+
+    def send() -> None:   # started before the block, so it does not block SIGINT: the kernel delivers it here
+        go.wait(5)
+        os.kill(os.getpid(), signal.SIGINT)
+        sent.set()
+
+    sender = threading.Thread(target=send)
+    sender.start()
+    finished = False
+    with pytest.raises(KeyboardInterrupt):
+        with sigint_held():
+            go.set()
+            sent.wait(5)
+            for _ in range(200):   # many bytecodes: the handler would have run by now
+                time.sleep(0.001)
+            finished = True
+    sender.join()
+    assert finished and sent.is_set()
