@@ -432,7 +432,7 @@ def _march(flow, polys, case, q: Quality, checkpoint, checkpoint_every, progress
     pose = case.motion().pose(sim.t)
     snap = flow_snapshot(grid, sim.u.numpy(), sim.v.numpy(), sim.p.numpy(), polys, pose, sim.t)
     body = getattr(flow, "body", None)   # the overset pair's body grid: the section's own detail
-    if body is not None:
+    if body is not None and hasattr(body.grid, "dx"):   # a Cartesian body grid (the O-grid has no picture yet)
         snap["body_grid"] = body_grid_snapshot(snap, body.grid, body.u.numpy(), body.v.numpy(), body.p.numpy(),
                                                polys, pose)
     return ForceRecord(**arrays, steps=flow.n_steps, wall_s=time.perf_counter() - t0, resumed_from_step=resumed,

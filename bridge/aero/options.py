@@ -76,6 +76,9 @@ class AeroOptions:
 
         if self.grid not in GRIDS:
             raise InputError("aero.grid", self.grid, f"one of {', '.join(GRIDS)}")
+        if self.grid == "body_fitted" and self.turbulence != "laminar":
+            raise InputError("aero.turbulence", self.turbulence, "with grid = \"body_fitted\": \"laminar\" only (the "
+                             "SST model's wall treatment on the body-fitted grid is not written yet)")
 
         if self.quality not in QUALITY:
             raise InputError("aero.quality", self.quality, f"one of {', '.join(QUALITY)}")

@@ -31,7 +31,7 @@ __all__ = ["GridSpec", "Physics", "RunLength", "Quality", "QUALITY", "SHORT_DOMA
            "TURBULENCE", "SST_WALLS", "USER_SST_WALLS", "check_flow_model", "build_flow", "preset_grid",
            "section_polygons"]
 
-GRIDS = ("single", "overset")
+GRIDS = ("single", "overset", "body_fitted")
 TURBULENCE = ("laminar", "sst")
 SST_WALLS = ("equilibrium", "function", "blended", "resolved")
 USER_SST_WALLS = SST_WALLS[:3]   # "resolved" is a diagnostic of the tools, not a scenario's choice
@@ -65,6 +65,14 @@ class GridSpec:
     overset: bool = False
     background_coarsening: int = 2
     body_margin: float = 0.35
+    # the body-fitted grid (bridge.cfd.curvilinear, bridge.cfd.body_fitted): an O-grid round the section reaching
+    # body_margin chords beyond it, over the overset pair's background; its wall cells first_height chords
+    # high (0: 0.1 / cells_per_chord), each layer growth times thicker, around_per_chord nodes per chord of the
+    # outline (0: 2 cells_per_chord)
+    body_fitted: bool = False
+    first_height: float = 0.0
+    growth: float = 1.1
+    around_per_chord: float = 0.0
 
     def __post_init__(self):
         check_range("aero.cells_per_chord", self.cells_per_chord, 8, 2000)
@@ -76,6 +84,11 @@ class GridSpec:
         check_range("aero.stretch", self.stretch, 1.0, 1.5, low_open=False)
         check_range("aero.background_coarsening", self.background_coarsening, 1, 16)
         check_range("aero.body_margin", self.body_margin, 0.05, 5.0)
+        check_range("aero.first_height", self.first_height, 0.0, 0.1)
+        check_range("aero.growth", self.growth, 1.0, 1.2)
+        check_range("aero.around_per_chord", self.around_per_chord, 0.0, 5000.0)
+        if self.body_fitted and self.overset:
+            raise InputError("aero.grid", "overset and body_fitted", "one of them")
 
 
 @dataclass(frozen=True)
@@ -179,7 +192,7 @@ def preset(quality: str, grid: str = "single") -> Quality:
         raise InputError("aero.quality", quality, f"one of {', '.join(QUALITY)}")
     if grid not in GRIDS:
         raise InputError("aero.grid", grid, f"one of {', '.join(GRIDS)}")
-    return QUALITY[quality].with_(overset=grid == "overset")
+    return QUALITY[quality].with_(overset=grid == "overset", body_fitted=grid == "body_fitted")
 
 
 def section_polygons(section) -> list:
@@ -222,13 +235,15 @@ def build_flow(q: Quality, polygons: list, case, threads: int | None = None):
     if not polygons:
         raise ValueError("build_flow: no polygon")
     _check_fits(q, polygons, case)
+    if q.grid.body_fitted:
+        return _body_fitted_flow(q, polygons, case, threads)
     return (_overset_flow if q.grid.overset else _single_grid_flow)(q, polygons, case, threads)
 
 
 def _check_fits(q: Quality, polygons: list, case) -> None:
     """The section inside the single grid's length, with 4 cells to spare at either end (the grids grow
     across the stream to hold the motion, and the overset background grows along it to hold the body grid)."""
-    if q.grid.overset:
+    if q.grid.overset or q.grid.body_fitted:
         return
     g = q.grid
     xs = np.concatenate([p.vertices[:, 0] for p in polygons])
@@ -291,4 +306,44 @@ def _overset_flow(q: Quality, polygons: list, case, threads: int | None):
     pair.set_uniform_flow(1.0)
     if q.physics.turbulence == "sst":
         OversetSST(pair, *freestream_turbulence(1.0, 1.0 / q.physics.reynolds), body_walls=q.physics.sst_walls)
+    return pair
+
+
+def _body_fitted_flow(q: Quality, polygons: list, case, threads: int | None):
+    """The section in a body-fitted O-grid that moves with it over the overset pair's background
+    (bridge.cfd.body_fitted.BodyFittedPair): laminar; one outline (appendages are not resolved yet)."""
+    from bridge.cfd import CartesianGrid
+    from bridge.cfd.body_fitted import BodyFittedPair
+    from bridge.cfd.curvilinear import CurvilinearGrid
+    from bridge.cfd.ogrid import o_grid
+
+    if q.physics.turbulence != "laminar":
+        raise InputError("aero.turbulence", q.physics.turbulence, "with grid = \"body_fitted\": \"laminar\" only "
+                         "(the SST model's wall treatment on the body-fitted grid is not written yet)")
+    if len(polygons) > 1:
+        raise InputError("aero.grid", "body_fitted", f"one outline only: this section has {len(polygons)} parts (the "
+                         "body-fitted grid does not resolve railings or screens yet); use grid = \"overset\"")
+    g = q.grid
+    outline = polygons[0].vertices
+    x, y = outline[:, 0], outline[:, 1]
+    perimeter = float(np.hypot(np.diff(x, append=x[0]), np.diff(y, append=y[0])).sum())
+    n_around = int(round(perimeter * (g.around_per_chord or 2.0 * g.cells_per_chord)))
+    first = g.first_height or 0.1 / g.cells_per_chord
+    H = g.background_coarsening / g.cells_per_chord
+    margin = max(g.body_margin, 8 * H)   # the hole (4 background cells inside the O-grid) leaves rings to overlap
+    try:
+        og = o_grid(outline, n_around, first, g.growth, margin)
+    except ValueError as err:   # an outline the generator cannot mesh: the user's section, named where
+        raise InputError("deck_section", "outline", f"cannot be meshed by the body-fitted grid: {err}") from None
+    ogrid = CurvilinearGrid(og.x, og.y)
+    xs, ys = ogrid.x.ravel(), ogrid.y.ravel()
+    reach_r = float(np.hypot(xs, ys).max())
+    reach = float(np.abs(ys).max()) + case.excursion(reach_r)
+    extent = CartesianGrid.uniform(4, 4, (xs.min(), xs.max()), (ys.min(), ys.max()))
+    background = preset_grid(q, reach + 4 * H, h=H, upstream=max(g.upstream, -extent.x_faces[0] + 8 * H),
+                             downstream=max(g.downstream, extent.x_faces[-1] + 8 * H), side_cells=8)
+    if threads is None:
+        threads = 1 if background.nx * background.ny < 20_000 else 2
+    pair = BodyFittedPair(background, ogrid, _flow_config(q, threads), case.motion())
+    pair.set_uniform_flow(1.0)
     return pair

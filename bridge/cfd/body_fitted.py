@@ -1,0 +1,421 @@
+"""Overset pair of a body-fitted O-grid (bridge/cfd/curvilinear.py), moving rigidly with the body, and a fixed
+Cartesian background (bridge/cfd/time_stepping.py).
+
+The coupling follows the Cartesian pair's (bridge/cfd/overset.py), through the stream function, so that mass
+is conserved across the interface to round-off in both directions:
+* the O-grid's outer boundary: its face fluxes from differences of the background's stream function at the
+  outer ring's nodes (cubic, bridge.cfd.overset.CornerInterpolator; they telescope to zero around the ring),
+  the velocity of its two ghost rings from the background's faces (bilinear), both at the step's new time
+  (the background steps first);
+* the background's hole: the faces whose corners lie inside ring ``j_hole`` of the O-grid (the ring at least
+  ``overlap`` background cells inside the outer one) take the O-grid's velocity, from differences of the
+  O-grid's stream function (its node values, summed from the face fluxes) interpolated at their corners
+  (cubic in the O-grid's index space: donor cells found by a nearest-cell search and the inverse of their
+  bilinear map), extrapolated in time from the O-grid's last two steps; corners inside the body take the
+  stream function of its rigid motion, matched to the O-grid's on the wall.  The forced faces carry the O-grid
+  pressure's gradient as the projection's compensation (as the Cartesian pair's).
+The force is the O-grid's wall integral of pressure and shear.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from matplotlib.path import Path as _Path
+from scipy.spatial import cKDTree
+
+from .curvilinear import CurvilinearFlow, CurvilinearGrid
+from .flow import LAMINAR, FlowBase
+from .grids import GHOST
+from .overset import CornerInterpolator, stream_function
+from .time_stepping import FlowConfig, Simulation, SubstepHook
+
+__all__ = ["OGridLocator", "BodyFittedPair"]
+
+
+def _lagrange4(f: np.ndarray) -> np.ndarray:
+    """Cubic Lagrange weights on the nodes -1, 0, 1, 2 at the fractions f (n,): (n, 4)."""
+    return np.stack([-f * (f - 1) * (f - 2) / 6, (f + 1) * (f - 1) * (f - 2) / 2, -(f + 1) * f * (f - 2) / 2,
+                     (f + 1) * f * (f - 1) / 6], axis=1)
+
+
+class OGridLocator:
+    """Where points lie in an O-grid: their fractional node index (j + t, i + s) from a nearest-cell search
+    and the inverse of the cell's bilinear map, and interpolation of node fields (cubic in index space) and cell
+    fields (bilinear) there.  Points outside the grid (inside the body, or beyond the outer ring) get NaN."""
+
+    def __init__(self, grid: CurvilinearGrid):
+        self.grid = grid
+        self._tree = cKDTree(np.column_stack([grid.xc.ravel(), grid.yc.ravel()]))
+
+    def locate(self, px: np.ndarray, py: np.ndarray, walks: int = 8) -> tuple[np.ndarray, np.ndarray]:
+        g = self.grid
+        nj, ni = g.nj, g.ni
+        px, py = np.asarray(px, dtype=np.float64).ravel(), np.asarray(py, dtype=np.float64).ravel()
+        _, k = self._tree.query(np.column_stack([px, py]))
+        j, i = np.divmod(k, ni)
+        s = np.full(px.size, 0.5)
+        t = np.full(px.size, 0.5)
+        found = np.zeros(px.size, dtype=bool)
+        for _ in range(walks):
+            todo = ~found
+            if not todo.any():
+                break
+            jj, ii = j[todo], i[todo]
+            s_, t_ = self._invert(jj, ii, px[todo], py[todo])
+            inside = (s_ >= -1e-9) & (s_ <= 1 + 1e-9) & (t_ >= -1e-9) & (t_ <= 1 + 1e-9)
+            idx = np.nonzero(todo)[0]
+            s[idx], t[idx] = s_, t_
+            found[idx[inside]] = True
+            # walk one cell towards the point; rings beyond the grid: give up
+            out = idx[~inside]
+            di = np.where(s_[~inside] < 0, -1, np.where(s_[~inside] > 1, 1, 0))
+            dj = np.where(t_[~inside] < 0, -1, np.where(t_[~inside] > 1, 1, 0))
+            i[out] = (i[out] + di) % ni
+            j[out] = j[out] + dj
+            lost = (j[out] < 0) | (j[out] >= nj)
+            j[out[lost]] = np.clip(j[out[lost]], 0, nj - 1)
+            found[out[lost]] = False
+            s[out[lost]] = np.nan
+        jf = np.where(found, j + np.clip(t, 0, 1), np.nan)
+        if_ = np.where(found, i + np.clip(s, 0, 1), np.nan)
+        return jf, if_
+
+    def _invert(self, j, i, px, py, iterations: int = 8):
+        """(s, t) of the points in the bilinear map of the cells (j, i) (Newton's method)."""
+        g, ni = self.grid, self.grid.ni
+        i1 = (i + 1) % ni
+        ax, ay = g.x[j, i], g.y[j, i]
+        bx, by = g.x[j, i1], g.y[j, i1]
+        cx, cy = g.x[j + 1, i1], g.y[j + 1, i1]
+        dx, dy = g.x[j + 1, i], g.y[j + 1, i]
+        s = np.full(px.shape, 0.5)
+        t = np.full(px.shape, 0.5)
+        for _ in range(iterations):
+            X = (1 - s) * (1 - t) * ax + s * (1 - t) * bx + s * t * cx + (1 - s) * t * dx
+            Y = (1 - s) * (1 - t) * ay + s * (1 - t) * by + s * t * cy + (1 - s) * t * dy
+            xs = (1 - t) * (bx - ax) + t * (cx - dx)
+            ys = (1 - t) * (by - ay) + t * (cy - dy)
+            xt = (1 - s) * (dx - ax) + s * (cx - bx)
+            yt = (1 - s) * (dy - ay) + s * (cy - by)
+            det = xs * yt - xt * ys
+            rx, ry = px - X, py - Y
+            s = s + (yt * rx - xt * ry) / det
+            t = t + (-ys * rx + xs * ry) / det
+        return s, t
+
+    def nodes(self, field: np.ndarray, jf: np.ndarray, if_: np.ndarray) -> np.ndarray:
+        """A node field (nj + 1, ni) at fractional node indices: cubic Lagrange in i (periodic) and j (the
+        stencil shifted inwards at the wall and the outer ring)."""
+        g = self.grid
+        j0 = np.clip(np.floor(jf).astype(int) - 1, 0, g.nj - 3)
+        i0 = np.floor(if_).astype(int) - 1
+        wj = _lagrange4(jf - j0 - 1)
+        wi = _lagrange4(if_ - i0 - 1)
+        out = np.zeros(jf.shape)
+        for a in range(4):
+            for b in range(4):
+                out += wj[:, a] * wi[:, b] * field[j0 + a, (i0 + b) % g.ni]
+        return out
+
+    def cells(self, field: np.ndarray, jf: np.ndarray, if_: np.ndarray) -> np.ndarray:
+        """A cell field (nj, ni) at fractional node indices, bilinear between the cell centres."""
+        g = self.grid
+        jc = np.clip(jf - 0.5, 0, g.nj - 1)
+        ic = if_ - 0.5
+        j0 = np.minimum(np.floor(jc).astype(int), g.nj - 2)
+        i0 = np.floor(ic).astype(int)
+        a, b = jc - j0, ic - i0
+        return ((1 - a) * ((1 - b) * field[j0, i0 % g.ni] + b * field[j0, (i0 + 1) % g.ni])
+                + a * ((1 - b) * field[j0 + 1, i0 % g.ni] + b * field[j0 + 1, (i0 + 1) % g.ni]))
+
+
+def node_stream_function(flow: CurvilinearFlow) -> np.ndarray:
+    """psi on the O-grid's nodes (nj + 1, ni) from its face fluxes: around the wall by the j-faces, then out
+    along each grid line by the i-faces; psi = 0 at node (0, 0).  Single-valued to round-off for
+    divergence-free fluxes and a body whose own flux sums to zero."""
+    s = flow.grid.orientation
+    wall = np.concatenate([[0.0], np.cumsum(-s * flow.Fj[0])[:-1]])
+    return np.vstack([wall[None], wall[None] + np.cumsum(s * flow.Fi, axis=0)])
+
+
+class _BackgroundOuter:
+    """The O-grid's outer boundary from the background (module doc); values of the last two times kept, so
+    that the O-grid's step gets its start's values as it had them."""
+
+    def __init__(self, pair: BodyFittedPair):
+        self.pair = pair
+        self._cache: dict[float, tuple] = {}
+
+    def attach(self, flow: CurvilinearFlow) -> None:
+        self.flow = flow
+
+    def _values(self, t: float):
+        if t in self._cache:
+            return self._cache[t]
+        pair, g = self.pair, self.flow.grid
+        bg = pair.background
+        X, Y = pair.to_background(g.xg, g.yg, t)
+        u, v = background_velocity(bg, X.ravel(), Y.ravel())
+        th = pair.motion.pose(t)[2]
+        c, s = math.cos(th), math.sin(th)
+        ub = (c * u + s * v).reshape(g.xg.shape)
+        vb = (-s * u + c * v).reshape(g.xg.shape)
+        Xn, Yn = pair.to_background(g.x[-1], g.y[-1], t)
+        psi = pair.background_psi_at(Xn, Yn)
+        fluxes = -g.orientation * (np.roll(psi, -1) - psi)
+        while len(self._cache) >= 2:
+            del self._cache[min(self._cache)]
+        self._cache[t] = ((ub, vb), fluxes)
+        return self._cache[t]
+
+    def ghost_velocity(self, t: float):
+        return self._values(t)[0]
+
+    def outer_fluxes(self, t: float) -> np.ndarray:
+        return self._values(t)[1]
+
+
+def background_velocity(sim: Simulation, X: np.ndarray, Y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The background's u and v at points, bilinear between its faces (u on x_faces x y_centres, v on
+    x_centres x y_faces)."""
+    grid, g = sim.grid, GHOST
+    u, v = sim.u.numpy(), sim.v.numpy()
+
+    def bilinear(field, xs, ys, row0, col0):
+        fi = (X - xs[0]) / grid.dx
+        i = np.clip(np.floor(fi).astype(int), 0, xs.size - 2)
+        a = fi - i
+        j = np.clip(np.searchsorted(ys, Y) - 1, 0, ys.size - 2)
+        b = (Y - ys[j]) / (ys[j + 1] - ys[j])
+        return ((1 - b) * ((1 - a) * field[row0 + j, col0 + i] + a * field[row0 + j, col0 + i + 1])
+                + b * ((1 - a) * field[row0 + j + 1, col0 + i] + a * field[row0 + j + 1, col0 + i + 1]))
+
+    uu = bilinear(u, grid.x_faces, grid.y_centres, g, g)
+    vv = bilinear(v, grid.x_centres, grid.y_faces, g, g)
+    return uu, vv
+
+
+class _HoleFaces(SubstepHook):
+    """Background: the faces inside the hole take the O-grid's velocity (module doc)."""
+
+    def __init__(self, pair: BodyFittedPair):
+        self.pair = pair
+        self._t, self._targets = None, None
+
+    def after_predict(self, sim, k, t_new, c):
+        if self._t != t_new:
+            self._targets, self._t = self.pair.hole_targets(t_new), t_new
+        if self._targets is None:
+            return
+        (ju, iu, tu, gu), (jv, iv, tv, gv) = self._targets
+        us, vs = sim.u_star.numpy(), sim.v_star.numpy()
+        us[ju, iu] = tu + c * gu
+        vs[jv, iv] = tv + c * gv
+        if not sim.L.device.is_cpu:
+            sim.u_star.assign(us)
+            sim.v_star.assign(vs)
+
+
+class BodyFittedPair(FlowBase):
+    """A body-fitted O-grid flow over a fixed Cartesian background (module doc): a flow of bridge/cfd/flow.py.
+
+    ``ogrid``: a :class:`CurvilinearGrid` in the body's coordinates (the reference point at 0); ``background``:
+    a ``CartesianGrid``; ``config``: the background's ``FlowConfig`` (its nu and cfl serve the O-grid too);
+    ``motion``: the body's rigid motion; ``overlap``: the hole starts this many background cells inside the
+    O-grid's outer ring, and at least ``ring_overlap`` of the O-grid's rings."""
+
+    def __init__(self, background_grid, ogrid: CurvilinearGrid, config: FlowConfig, motion, overlap: float = 4.0,
+                 ring_overlap: int = 4, device: str | None = None):
+        if overlap < 2:
+            raise ValueError(f"overlap: must be >= 2 background cells, got {overlap}")
+        self.motion, self.config, self.overlap = motion, config, float(overlap)
+        self.background = Simulation(background_grid, config, device=device)
+        self.body = CurvilinearFlow(ogrid, config.nu, motion, _BackgroundOuter(self), cfl=config.cfl, rho=config.rho)
+        self.locator = OGridLocator(ogrid)
+        bg = background_grid
+        # the background's largest spacing where the O-grid is (its initial place, any rotation: within its
+        # outer radius of the reference point)
+        x0, y0 = motion.pose(0.0)[:2]
+        reach = float(np.hypot(ogrid.x[-1], ogrid.y[-1]).max())
+        near = (bg.y_faces[1:] > y0 - reach) & (bg.y_faces[:-1] < y0 + reach)
+        h = max(bg.dx, float(np.max(bg.dy[near])) if near.any() else float(np.max(bg.dy)))
+        # the hole's ring: the outermost ring at least ``overlap`` background cells inside the outer ring
+        depth = np.hypot(ogrid.x - ogrid.x[-1], ogrid.y - ogrid.y[-1]).min(axis=1)
+        # and at least ``ring_overlap`` of the O-grid's own rings: its outer rings solve their own equations
+        # only where the background does too (a hole edge one ring inside the outer ring left the two grids
+        # disagreeing in a steady state: DFG 2D-1's c_D 14 % high)
+        rings = np.nonzero((depth >= self.overlap * h) & (np.arange(ogrid.nj + 1) <= ogrid.nj - ring_overlap))[0]
+        if rings.size == 0 or rings.max() < 1:
+            raise ValueError(f"ogrid: its rings reach {depth.max():.4g} from the outer one, fewer than overlap x h = "
+                             f"{self.overlap * h:.4g}: no hole left; make the O-grid reach farther")
+        self.j_hole = int(rings.max())
+        self._hole_path = _Path(np.column_stack([ogrid.x[self.j_hole], ogrid.y[self.j_hole]]))
+        self._body_path = _Path(np.column_stack([ogrid.x[0], ogrid.y[0]]))
+        self._hole_hook = _HoleFaces(self)
+        self.background.hooks.append(self._hole_hook)
+        self._psi_hist: list[tuple[float, np.ndarray]] = []
+        self._hy_f = background_grid.hy_faces()
+        self.turbulence = LAMINAR
+        self.t, self.n_steps = 0.0, 0
+
+    # --- set-up and frames --------------------------------------------------------------------------
+    def set_uniform_flow(self, u_inf: float, t: float = 0.0) -> None:
+        """Both grids in a uniform stream (u_inf, 0); the O-grid's projected to be divergence-free."""
+        self.background.set_state(u=u_inf, v=0.0, t=t)
+        self.set_initial_body_state()
+
+    def set_initial_body_state(self) -> None:
+        """The O-grid's state from the background's (set first, e.g. by ``background.set_state``) at the
+        background's time: the background's velocity at its cells, projected so that its fluxes are the
+        background's through the outer ring and the wall's own through the wall."""
+        t = self.background.t
+        g = self.body.grid
+        self.body.t = self.t = t
+        X, Y = self.to_background(g.xc, g.yc, t)
+        u, v = background_velocity(self.background, X.ravel(), Y.ravel())
+        th = self.motion.pose(t)[2]
+        c, s = math.cos(th), math.sin(th)
+        ub, vb = (c * u + s * v).reshape(g.xc.shape), (-s * u + c * v).reshape(g.xc.shape)
+        self.body.outer._cache = {}
+        self.body._H = self.body._q_old = None
+        self.body._project(ub, vb, t, dt=1.0, accumulate=False)
+        self._psi_hist = [(t, node_stream_function(self.body))]
+        self._hole_hook._t = None
+
+    def to_background(self, xi, eta, t):
+        x, y, th = self.motion.pose(t)
+        c, s = math.cos(th), math.sin(th)
+        return x + c * xi - s * eta, y + s * xi + c * eta
+
+    def to_body(self, X, Y, t):
+        x, y, th = self.motion.pose(t)
+        c, s = math.cos(th), math.sin(th)
+        dx, dy = X - x, Y - y
+        return c * dx + s * dy, -s * dx + c * dy
+
+    def background_psi_at(self, X: np.ndarray, Y: np.ndarray) -> np.ndarray:
+        """The background's stream function at points of the inertial frame (cubic), at the background's time."""
+        grid = self.background.grid
+        pad = 3
+        i0 = max(int(np.floor((X.min() - grid.x_faces[0]) / grid.dx)) - pad, 0)
+        i1 = min(int(np.ceil((X.max() - grid.x_faces[0]) / grid.dx)) + pad, grid.nx)
+        j0 = max(int(np.searchsorted(grid.y_faces, Y.min())) - pad, 0)
+        j1 = min(int(np.searchsorted(grid.y_faces, Y.max())) + pad, grid.ny)
+        if i0 == 0 or j0 == 0 or i1 == grid.nx or j1 == grid.ny:
+            raise ValueError("ogrid: its outer ring comes within 3 cells of the background's boundary")
+        psi = stream_function(self.background, i0, i1, j0, j1)
+        return CornerInterpolator(grid.x_faces[i0:i1 + 1], grid.y_faces[j0:j1 + 1])(psi, X, Y)
+
+    # --- O-grid -> background ------------------------------------------------------------------------
+    def _body_psi(self, t_new: float) -> np.ndarray:
+        (t1, psi1) = self._psi_hist[-1]
+        if len(self._psi_hist) < 2 or t_new == t1:
+            return psi1
+        (t0, psi0) = self._psi_hist[-2]
+        return psi1 + (t_new - t1) / (t1 - t0) * (psi1 - psi0)
+
+    def _rigid_psi(self, xi, eta, t):
+        """The stream function of the body's rigid motion in body coordinates (up to a constant)."""
+        ub, vb, om = self.body.frame_velocity(t)
+        return ub * eta - vb * xi - 0.5 * om * (xi * xi + eta * eta)
+
+    def hole_targets(self, t_new: float):
+        """Background faces inside the hole at t_new with their velocity targets and the O-grid pressure's
+        gradient on them, as storage indices ((J_u, I_u, u, dp/dx), (J_v, I_v, v, dp/dy)); None if none."""
+        g, grid = GHOST, self.background.grid
+        og = self.body.grid
+        X, Y = self.to_background(og.x[self.j_hole], og.y[self.j_hole], t_new)
+        i0 = max(int(np.floor((X.min() - grid.x_faces[0]) / grid.dx)), 1)
+        i1 = min(int(np.ceil((X.max() - grid.x_faces[0]) / grid.dx)), grid.nx - 1)
+        j0 = max(int(np.searchsorted(grid.y_faces, Y.min())) - 1, 1)
+        j1 = min(int(np.searchsorted(grid.y_faces, Y.max())), grid.ny - 1)
+        XC, YC = np.meshgrid(grid.x_faces[i0:i1 + 1], grid.y_faces[j0:j1 + 1])
+        xi, eta = self.to_body(XC, YC, t_new)
+        pts = np.column_stack([xi.ravel(), eta.ravel()])
+        inside = self._hole_path.contains_points(pts).reshape(xi.shape)
+        if not inside.any():
+            return None
+        solid = self._body_path.contains_points(pts).reshape(xi.shape) & inside
+        fluid = inside & ~solid
+        psi_nodes = self._body_psi(t_new)
+        psi = np.zeros(inside.shape)
+        jf, if_ = self.locator.locate(xi[fluid], eta[fluid])
+        ok = np.isfinite(jf)
+        vals = np.zeros(jf.shape)
+        vals[ok] = self.locator.nodes(psi_nodes, jf[ok], if_[ok])
+        # a corner the search did not place (at a cell edge of the wall ring, round-off): the rigid motion's
+        rigid_const = float(np.mean(psi_nodes[0] - self._rigid_psi(og.x[0], og.y[0], t_new)))
+        vals[~ok] = self._rigid_psi(xi[fluid][~ok], eta[fluid][~ok], t_new) + rigid_const
+        psi[fluid] = vals
+        psi[solid] = self._rigid_psi(xi[solid], eta[solid], t_new) + rigid_const
+        hy = grid.hy_cells()[g + j0:g + j1]
+        fu = inside[:-1, :] & inside[1:, :]
+        fv = inside[:, :-1] & inside[:, 1:]
+        ju, iu = np.nonzero(fu)
+        jv, iv = np.nonzero(fv)
+        tu = (psi[ju + 1, iu] - psi[ju, iu]) / hy[ju]
+        tv = -(psi[jv, iv + 1] - psi[jv, iv]) / grid.dx
+        # the O-grid's pressure at the background's cell centres round the hole (none inside the body)
+        XP, YP = np.meshgrid(grid.x_centres[i0 - 1:i1 + 1], grid.y_centres[j0 - 1:j1 + 1])
+        xp, yp = self.to_body(XP, YP, t_new)
+        pj, pi = self.locator.locate(xp, yp)
+        P = np.zeros(pj.shape)
+        okp = np.isfinite(pj)
+        P[okp] = self.locator.cells(self.body.p, pj[okp], pi[okp])
+        P = P.reshape(xp.shape)
+        okp = okp.reshape(xp.shape)
+        gu = np.where(okp[ju + 1, iu + 1] & okp[ju + 1, iu], (P[ju + 1, iu + 1] - P[ju + 1, iu]) / grid.dx, 0.0)
+        gv = np.where(okp[jv + 1, iv + 1] & okp[jv, iv + 1],
+                      (P[jv + 1, iv + 1] - P[jv, iv + 1]) / self._hy_f[jv + j0 + g], 0.0)
+        # the O-grid's pressure is in body axes' frame, a scalar: its gradient along the background's axes
+        return (ju + j0 + g, iu + i0 + g, tu, gu), (jv + j0 + g, iv + i0 + g, tv, gv)
+
+    # --- step ----------------------------------------------------------------------------------
+    def _flow_dt(self) -> float:
+        return min(self.background.stable_dt(), self.body.stable_dt())
+
+    def _advance_flow(self, dt: float) -> None:
+        self.background.step(dt)
+        self.body.step(dt)
+        self.t = self.body.t
+        self._psi_hist = [self._psi_hist[-1], (self.t, node_stream_function(self.body))]
+        self.n_steps += 1
+
+    @property
+    def total_force(self) -> np.ndarray:
+        return self.body.total_force
+
+    last_force = total_force
+
+    @property
+    def simulations(self) -> list[Simulation]:
+        return [self.background]
+
+    @property
+    def n_cells(self) -> int:
+        return self.background.grid.nx * self.background.grid.ny + self.body.grid.n_cells
+
+    def describe(self) -> str:
+        b = self.background.grid
+        return f"{b.nx} x {b.ny} + O-grid {self.body.grid.ni} x {self.body.grid.nj} cells"
+
+    def checkpoint_arrays(self) -> dict[str, np.ndarray]:
+        out = {f"background/{f}": a for f, a in self.background.state.arrays().items()}
+        out.update({f"body/{f}": a for f, a in self.body.checkpoint_arrays().items()})
+        out["psi_times"] = np.array([t for t, _ in self._psi_hist])
+        for k, (_, psi) in enumerate(self._psi_hist):
+            out[f"psi_{k}"] = psi
+        return out
+
+    def restore_arrays(self, arrays: dict[str, np.ndarray], t: float, n_steps: int) -> None:
+        self.background.state.assign({f: arrays[f"background/{f}"] for f in self.background.state.fields})
+        self.background.t, self.background.n_steps = float(t), int(n_steps)
+        self.body.restore_arrays({k[5:]: v for k, v in arrays.items() if k.startswith("body/")}, t, n_steps)
+        self.t, self.n_steps = float(t), int(n_steps)
+        times = np.atleast_1d(arrays["psi_times"])
+        self._psi_hist = [(float(tk), np.asarray(arrays[f"psi_{k}"])) for k, tk in enumerate(times)]
+        self._hole_hook._t = None
+        self.body.outer._cache = {}
+        self.body.outer._values(self.t)   # the boundary values at the step's start, from the background now
