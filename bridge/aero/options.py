@@ -19,7 +19,10 @@ Keys (all optional):
     grid                  "overset" (default): the section in a fine grid that moves with it over a coarser
                           fixed background (bridge/cfd/overset.py; no face of the body changes class as it
                           moves); "single": one grid, the section an immersed body moving on it (with "sst"
-                          its forces jitter as the faces change class: docs/cfd.md, "Immersed boundary")
+                          its forces jitter as the faces change class: docs/cfd.md, "Immersed boundary");
+                          "body_fitted": an O-grid graded from the section's wall over the same background
+                          (bridge/cfd/body_fitted.py; laminar and one outline only so far: docs/cfd.md,
+                          "Body-fitted grid")
     turbulence            "sst" (default): the k-omega SST model (2003 variant) with Spalding's wall function on
                           the section, at the deck's Reynolds number Re = wind_speed_m_s B / nu_air ([air]
                           kinematic viscosity), on either grid (bridge/cfd/turbulence.py, docs/cfd.md);

@@ -516,6 +516,10 @@ class CurvilinearFlow(FlowBase):
         self.t, self.n_steps, self.last_dt = t_new, self.n_steps + 1, dt
         self.last_force = self._force(t_new)
 
+    def pressure_gradient(self) -> tuple[np.ndarray, np.ndarray]:
+        """grad p at the cell centres (Green-Gauss, the boundary faces' values extrapolated), body axes."""
+        return ((self._Gcx @ self.p.ravel()).reshape(self.p.shape), (self._Gcy @ self.p.ravel()).reshape(self.p.shape))
+
     # --- loads ------------------------------------------------------------------------------------
     def wall_pressure(self) -> np.ndarray:
         """p on the wall faces, extrapolated linearly from the first two rings along the grid lines."""

@@ -94,6 +94,7 @@ def test_an_internal_error_while_building_a_flow_is_not_relabelled_as_the_users(
         run_case(section_polygons(FlatPlate(1.0, 0.04)), StaticCase(0.0), QUALITY["tiny"])
 
 
+@pytest.mark.slow   # 4 s: a subprocess importing the program
 def test_the_example_script_prints_the_pitch_derivatives_of_a_section():
     out = subprocess.run([sys.executable, str(REPO / "tools" / "example_pitch.py"), "--quality", "tiny",
                           "--reduced-velocities", "4"], capture_output=True, text=True, timeout=300, cwd=REPO)
