@@ -28,7 +28,7 @@ from scipy.spatial import cKDTree
 from .curvilinear import CurvilinearFlow, CurvilinearGrid
 from .flow import LAMINAR, FlowBase
 from .grids import GHOST
-from .overset import CornerInterpolator, stream_function
+from .overset import CornerInterpolator, RigidPair, stream_function
 from .time_stepping import FlowConfig, Simulation, SubstepHook
 
 __all__ = ["OGridLocator", "BodyFittedPair"]
@@ -257,7 +257,7 @@ class _HoleFaces(SubstepHook):
             sim.v_star.assign(vs)
 
 
-class BodyFittedPair(FlowBase):
+class BodyFittedPair(RigidPair, FlowBase):
     """A body-fitted O-grid flow over a fixed Cartesian background (module doc): a flow of bridge/cfd/flow.py.
 
     ``ogrid``: a :class:`CurvilinearGrid` in the body's coordinates (the reference point at 0); ``background``:
@@ -325,17 +325,6 @@ class BodyFittedPair(FlowBase):
         self._psi_hist = [(t, node_stream_function(self.body))]
         self._hole_hook._t = None
 
-    def to_background(self, xi, eta, t):
-        x, y, th = self.motion.pose(t)
-        c, s = math.cos(th), math.sin(th)
-        return x + c * xi - s * eta, y + s * xi + c * eta
-
-    def to_body(self, X, Y, t):
-        x, y, th = self.motion.pose(t)
-        c, s = math.cos(th), math.sin(th)
-        dx, dy = X - x, Y - y
-        return c * dx + s * dy, -s * dx + c * dy
-
     def background_psi_at(self, X: np.ndarray, Y: np.ndarray) -> np.ndarray:
         """The background's stream function at points of the inertial frame (cubic), at the background's time."""
         grid = self.background.grid
@@ -350,13 +339,6 @@ class BodyFittedPair(FlowBase):
         return CornerInterpolator(grid.x_faces[i0:i1 + 1], grid.y_faces[j0:j1 + 1])(psi, X, Y)
 
     # --- O-grid -> background ------------------------------------------------------------------------
-    def _body_psi(self, t_new: float) -> np.ndarray:
-        (t1, psi1) = self._psi_hist[-1]
-        if len(self._psi_hist) < 2 or t_new == t1:
-            return psi1
-        (t0, psi0) = self._psi_hist[-2]
-        return psi1 + (t_new - t1) / (t1 - t0) * (psi1 - psi0)
-
     def _rigid_psi(self, xi, eta, t):
         """The stream function of the body's rigid motion in body coordinates (up to a constant)."""
         ub, vb, om = self.body.frame_velocity(t)

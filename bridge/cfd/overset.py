@@ -64,7 +64,7 @@ from .grids import GHOST, CartesianGrid
 from .immersed import ImmersedBody
 from .time_stepping import FlowConfig, Simulation, SubstepHook
 
-__all__ = ["OversetPair", "CornerInterpolator", "stream_function"]
+__all__ = ["OversetPair", "RigidPair", "CornerInterpolator", "stream_function"]
 
 
 def _rotation(theta: float) -> np.ndarray:
@@ -241,7 +241,32 @@ class _Hole(SubstepHook):
         self.pair.sync_device(sim, (sim.u_star, us), (sim.v_star, vs))
 
 
-class OversetPair(FlowBase):
+class RigidPair:
+    """What both overset pairs (this module's and bridge.cfd.body_fitted's) share: a body grid moving rigidly
+    with ``self.motion`` over a fixed background, its stream function of the last two steps in
+    ``self._psi_hist`` for the background's hole."""
+
+    def to_background(self, xi: np.ndarray, eta: np.ndarray, t: float):
+        x, y, th = self.motion.pose(t)
+        c, s = math.cos(th), math.sin(th)
+        return x + c * xi - s * eta, y + s * xi + c * eta
+
+    def to_body(self, X: np.ndarray, Y: np.ndarray, t: float):
+        x, y, th = self.motion.pose(t)
+        c, s = math.cos(th), math.sin(th)
+        dx, dy = X - x, Y - y
+        return c * dx + s * dy, -s * dx + c * dy
+
+    def _body_psi(self, t_new: float) -> np.ndarray:
+        """The body grid's psi extrapolated linearly in time from its last two steps to t_new."""
+        (t1, psi1) = self._psi_hist[-1]
+        if len(self._psi_hist) < 2 or t_new == t1:
+            return psi1
+        (t0, psi0) = self._psi_hist[-2]
+        return psi1 + (t_new - t1) / (t1 - t0) * (psi1 - psi0)
+
+
+class OversetPair(RigidPair, FlowBase):
     """A fixed background ``Simulation`` and a body ``Simulation`` on a uniform grid in body
     coordinates, coupled every stage (module doc): a flow (bridge.cfd.flow.Flow), whose turbulence model
     is one of both grids (``OversetSST(pair, ...)`` makes itself the pair's model).
@@ -328,17 +353,6 @@ class OversetPair(FlowBase):
     def frame_velocity(self, t: float) -> tuple[float, float, float]:
         return _FrameMotion(self.motion).velocity(t)
 
-    def to_background(self, xi: np.ndarray, eta: np.ndarray, t: float):
-        x, y, th = self.motion.pose(t)
-        c, s = math.cos(th), math.sin(th)
-        return x + c * xi - s * eta, y + s * xi + c * eta
-
-    def to_body(self, X: np.ndarray, Y: np.ndarray, t: float):
-        x, y, th = self.motion.pose(t)
-        c, s = math.cos(th), math.sin(th)
-        dx, dy = X - x, Y - y
-        return c * dx + s * dy, -s * dx + c * dy
-
     @staticmethod
     def sync_device(sim, *pairs) -> None:
         """After host edits of ``.numpy()`` views: copy back where the view was a copy (CUDA)."""
@@ -364,14 +378,6 @@ class OversetPair(FlowBase):
         return interp(psi, X, Y)
 
     # --- body grid -> background ------------------------------------------------------------
-    def _body_psi(self, t_new: float) -> np.ndarray:
-        """The body grid's psi extrapolated linearly in time from its last two steps to t_new."""
-        (t1, psi1) = self._psi_hist[-1]
-        if len(self._psi_hist) < 2 or t_new == t1:
-            return psi1
-        (t0, psi0) = self._psi_hist[-2]
-        return psi1 + (t_new - t1) / (t1 - t0) * (psi1 - psi0)
-
     def hole_targets(self, t_new: float):
         """Background faces inside the hole at t_new, their velocity targets and the body grid's
         pressure gradient on them (the compensation, module doc), as storage indices
