@@ -5,6 +5,8 @@ and published benchmarks.
     python tools/validate_body_fitted.py cylinder --re 40   # O-grid alone in a uniform stream: C_D
     python tools/validate_body_fitted.py dfg --background 32 --around 128 --first 0.002 --t-end 5
                                                             # DFG 2D-1: O-grid over the Cartesian channel
+    python tools/validate_body_fitted.py dfg2 --background 32 --t-end 8 --window 2
+                                                            # DFG 2D-2: periodic shedding at Re 100
 
 * couette: circular Couette flow between a rotating inner cylinder (radius 1, in its own rotating frame) and a
   fixed outer one (radius 2), nu = 1: u_theta = A r + B / r, torque -4 pi nu Omega R1^2 R2^2 / (R2^2 - R1^2)
@@ -14,6 +16,8 @@ and published benchmarks.
 * dfg: the DFG benchmark 2D-1 (Schaefer and Turek 1996: channel 2.2 x 0.41, D = 0.1 at (0.2, 0.2), parabolic
   inflow U_max 0.3, nu 1e-3, Re 20): c_D 5.57-5.59, c_L 0.0104-0.0110; the cylinder's O-grid over a uniform
   background of D / ``--background``.
+* dfg2: DFG 2D-2 (U_max 1.5, Re 100, periodic shedding): c_D,max 3.22-3.24, c_L,max 0.99-1.01 and the
+  Strouhal number f D / U_mean 0.295-0.305 over the last ``--window`` time units.
 Each prints its rows and writes them to ``--out`` (JSON).  Progress goes to stderr.
 """
 
@@ -42,7 +46,8 @@ from bridge.cfd import (  # noqa: E402
 from bridge.cfd.body_fitted import BodyFittedPair  # noqa: E402
 from bridge.cfd.curvilinear import CurvilinearFlow, CurvilinearGrid, Farfield, polar_grid  # noqa: E402
 
-BANDS = {"cylinder40": (1.50, 1.58), "dfg_cd": (5.57, 5.59), "dfg_cl": (0.0104, 0.0110)}
+BANDS = {"cylinder40": (1.50, 1.58), "dfg_cd": (5.57, 5.59), "dfg_cl": (0.0104, 0.0110), "dfg2_cd": (3.22, 3.24),
+         "dfg2_cl": (0.99, 1.01), "dfg2_st": (0.295, 0.305)}
 
 
 class _CouetteOuter:
@@ -102,8 +107,9 @@ def cylinder(re=40.0, around=128, first=0.01, growth=1.08, outer=20.0, t_end=60.
             "c_D": cd, "band": BANDS["cylinder40"] if re == 40 else None}
 
 
-def dfg(background=32, around=128, first=0.002, growth=1.1, outer=0.12, t_end=5.0) -> dict:
-    d, h_ch, length, nu, umax = 0.1, 0.41, 2.2, 1e-3, 0.3
+def dfg(background=32, around=128, first=0.002, growth=1.1, outer=0.12, t_end=5.0, unsteady=False,
+        window=2.0) -> dict:
+    d, h_ch, length, nu, umax = 0.1, 0.41, 2.2, 1e-3, (1.5 if unsteady else 0.3)
 
     def profile(y, t):
         return 4 * umax * y * (h_ch - y) / h_ch ** 2
@@ -118,10 +124,24 @@ def dfg(background=32, around=128, first=0.002, growth=1.1, outer=0.12, t_end=5.
     pair.set_initial_body_state()
     t0 = time.perf_counter()
     history = []
+    name = "DFG 2D-2" if unsteady else "DFG 2D-1"
     run(pair, t_end, [lambda f: history.append((f.t, *f.total_force[:2])),
-                      ProgressNote(f"DFG 2D-1, background D/{background}, O-grid {around}", t_end)])
+                      ProgressNote(f"{name}, background D/{background}, O-grid {around}", t_end)])
     scale = 2 / ((2 * umax / 3) ** 2 * d)
     t, fx, fy = np.array(history).T
+    if unsteady:
+        sel = t > t[-1] - window
+        cl = scale * fy[sel]
+        ts = t[sel]
+        up = np.nonzero((cl[:-1] < cl.mean()) & (cl[1:] >= cl.mean()))[0]   # upward mean crossings
+        crossings = ts[up] + (cl.mean() - cl[up]) / (cl[up + 1] - cl[up]) * (ts[up + 1] - ts[up])
+        period = float(np.mean(np.diff(crossings))) if crossings.size > 1 else float("nan")
+        return {"case": "DFG 2D-2", "background_per_D": background, "around": around, "rings": pair.body.grid.nj,
+                "first": first, "growth": growth, "outer_radius": outer, "cells": pair.n_cells, "t_end": t_end,
+                "window": window, "steps": pair.n_steps, "wall_s": time.perf_counter() - t0,
+                "c_D_max": float(scale * fx[sel].max()), "c_L_max": float(cl.max()), "c_L_min": float(cl.min()),
+                "St": d / (period * 2 * umax / 3), "periods_in_window": int(max(crossings.size - 1, 0)),
+                "band_c_D_max": BANDS["dfg2_cd"], "band_c_L_max": BANDS["dfg2_cl"], "band_St": BANDS["dfg2_st"]}
     last = t > t[-1] - 0.5
     return {"case": "DFG 2D-1", "background_per_D": background, "around": around, "rings": pair.body.grid.nj,
             "first": first, "growth": growth, "outer_radius": outer, "cells": pair.n_cells, "t_end": t_end,
@@ -132,7 +152,8 @@ def dfg(background=32, around=128, first=0.002, growth=1.1, outer=0.12, t_end=5.
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("case", choices=("couette", "cylinder", "dfg"))
+    ap.add_argument("case", choices=("couette", "cylinder", "dfg", "dfg2"))
+    ap.add_argument("--window", type=float, default=2.0, help="dfg2: the time over which the maxima and St are taken")
     ap.add_argument("--re", type=float, default=40.0)
     ap.add_argument("--around", type=int, default=128, help="O-grid nodes around the body")
     ap.add_argument("--first", type=float, default=None, help="first cell height (cylinder: 0.01 D; dfg: 0.002)")
@@ -149,7 +170,7 @@ def main(argv=None) -> int:
                        args.t_end or 60.0)
     else:
         row = dfg(args.background, args.around, args.first or 0.002, args.growth or 1.1, args.outer or 0.12,
-                  args.t_end or 5.0)
+                  args.t_end or (8.0 if args.case == "dfg2" else 5.0), unsteady=args.case == "dfg2", window=args.window)
     print(json.dumps(row, indent=1))
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(json.dumps(row, indent=1))
