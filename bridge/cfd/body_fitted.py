@@ -28,7 +28,7 @@ from scipy.spatial import cKDTree
 from .curvilinear import CurvilinearFlow, CurvilinearGrid
 from .flow import LAMINAR, FlowBase
 from .grids import GHOST
-from .overset import CornerInterpolator, RigidPair, stream_function
+from .overset import RigidPair
 from .time_stepping import FlowConfig, Simulation, SubstepHook
 
 __all__ = ["OGridLocator", "BodyFittedPair"]
@@ -202,7 +202,7 @@ class _BackgroundOuter:
         ub = (c * u + s * v).reshape(g.xg.shape)
         vb = (-s * u + c * v).reshape(g.xg.shape)
         Xn, Yn = pair.to_background(g.x[-1], g.y[-1], t)
-        psi = pair.background_psi_at(Xn, Yn)
+        psi = pair.background_psi_inertial(Xn, Yn)
         fluxes = -g.orientation * (np.roll(psi, -1) - psi)
         while len(self._cache) >= 2:
             del self._cache[min(self._cache)]
@@ -325,19 +325,6 @@ class BodyFittedPair(RigidPair, FlowBase):
         self._psi_hist = [(t, node_stream_function(self.body))]
         self._hole_hook._t = None
 
-    def background_psi_at(self, X: np.ndarray, Y: np.ndarray) -> np.ndarray:
-        """The background's stream function at points of the inertial frame (cubic), at the background's time."""
-        grid = self.background.grid
-        pad = 3
-        i0 = max(int(np.floor((X.min() - grid.x_faces[0]) / grid.dx)) - pad, 0)
-        i1 = min(int(np.ceil((X.max() - grid.x_faces[0]) / grid.dx)) + pad, grid.nx)
-        j0 = max(int(np.searchsorted(grid.y_faces, Y.min())) - pad, 0)
-        j1 = min(int(np.searchsorted(grid.y_faces, Y.max())) + pad, grid.ny)
-        if i0 == 0 or j0 == 0 or i1 == grid.nx or j1 == grid.ny:
-            raise ValueError("ogrid: its outer ring comes within 3 cells of the background's boundary")
-        psi = stream_function(self.background, i0, i1, j0, j1)
-        return CornerInterpolator(grid.x_faces[i0:i1 + 1], grid.y_faces[j0:j1 + 1])(psi, X, Y)
-
     # --- O-grid -> background ------------------------------------------------------------------------
     def _rigid_psi(self, xi, eta, t):
         """The stream function of the body's rigid motion in body coordinates (up to a constant)."""
@@ -400,18 +387,8 @@ class BodyFittedPair(RigidPair, FlowBase):
     def _flow_dt(self) -> float:
         return min(self.background.stable_dt(), self.body.stable_dt())
 
-    def _advance_flow(self, dt: float) -> None:
-        self.background.step(dt)
-        self.body.step(dt)
-        self.t = self.body.t
-        self._psi_hist = [self._psi_hist[-1], (self.t, node_stream_function(self.body))]
-        self.n_steps += 1
-
-    @property
-    def total_force(self) -> np.ndarray:
-        return self.body.total_force
-
-    last_force = total_force
+    def _body_stream_function(self) -> np.ndarray:
+        return node_stream_function(self.body)
 
     @property
     def simulations(self) -> list[Simulation]:

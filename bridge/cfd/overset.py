@@ -265,6 +265,40 @@ class RigidPair:
         (t0, psi0) = self._psi_hist[-2]
         return psi1 + (t_new - t1) / (t1 - t0) * (psi1 - psi0)
 
+    def background_psi_inertial(self, X: np.ndarray, Y: np.ndarray) -> np.ndarray:
+        """The background's stream function at points of the inertial frame (cubic), at the background's time."""
+        grid = self.background.grid
+        pad = 3
+        i0 = max(int(np.floor((X.min() - grid.x_faces[0]) / grid.dx)) - pad, 0)
+        i1 = min(int(np.ceil((X.max() - grid.x_faces[0]) / grid.dx)) + pad, grid.nx)
+        j0 = max(int(np.searchsorted(grid.y_faces, Y.min())) - pad, 0)
+        j1 = min(int(np.searchsorted(grid.y_faces, Y.max())) + pad, grid.ny)
+        if i0 == 0 or j0 == 0 or i1 == grid.nx or j1 == grid.ny:
+            raise ValueError("body grid: its boundary comes within 3 cells of the background's boundary")
+        psi = stream_function(self.background, i0, i1, j0, j1)
+        return CornerInterpolator(grid.x_faces[i0:i1 + 1], grid.y_faces[j0:j1 + 1])(psi, X, Y)
+
+    def _body_stream_function(self) -> np.ndarray:
+        raise NotImplementedError
+
+    def _advance_flow(self, dt: float) -> None:
+        """Both grids by one step: the background first (hole from the body grid extrapolated to the new
+        time), then the body grid (its boundary from the background at the new time); ``step`` then advances
+        the turbulence model with the new velocities."""
+        self.background.step(dt)
+        self.body.step(dt)
+        self.t = self.body.t
+        self._psi_hist = [self._psi_hist[-1], (self.t, self._body_stream_function())]
+        self.n_steps += 1
+
+    @property
+    def total_force(self) -> np.ndarray:
+        """(F_x, F_y, M_z) on the body (all its polygons) over the last step, inertial axes, M_z about
+        the body's reference point (zeros without a body)."""
+        return self.body.total_force
+
+    last_force = total_force   # the pair's loads are always the sum over its polygons
+
 
 class OversetPair(RigidPair, FlowBase):
     """A fixed background ``Simulation`` and a body ``Simulation`` on a uniform grid in body
@@ -364,18 +398,7 @@ class OversetPair(RigidPair, FlowBase):
     def background_psi_at(self, xi: np.ndarray, eta: np.ndarray, t: float) -> np.ndarray:
         """The background's stream function at body-grid points (body coordinates) at time t; the
         background must already be at t."""
-        X, Y = self.to_background(xi, eta, t)
-        grid = self.background.grid
-        pad = 3
-        i0 = max(int(np.floor((X.min() - grid.x_faces[0]) / grid.dx)) - pad, 0)
-        i1 = min(int(np.ceil((X.max() - grid.x_faces[0]) / grid.dx)) + pad, grid.nx)
-        j0 = max(int(np.searchsorted(grid.y_faces, Y.min())) - pad, 0)
-        j1 = min(int(np.searchsorted(grid.y_faces, Y.max())) + pad, grid.ny)
-        if (i0 == 0 or j0 == 0 or i1 == grid.nx or j1 == grid.ny):
-            raise ValueError("body grid: its fringe comes within 3 cells of the background's boundary")
-        psi = stream_function(self.background, i0, i1, j0, j1)
-        interp = CornerInterpolator(grid.x_faces[i0:i1 + 1], grid.y_faces[j0:j1 + 1])
-        return interp(psi, X, Y)
+        return self.background_psi_inertial(*self.to_background(xi, eta, t))
 
     # --- body grid -> background ------------------------------------------------------------
     def hole_targets(self, t_new: float):
@@ -427,23 +450,8 @@ class OversetPair(RigidPair, FlowBase):
         self.body.set_frame_velocity(*self.frame_velocity(self.t))
         return min(self.background.stable_dt(), self.body.stable_dt())
 
-    def _advance_flow(self, dt: float) -> None:
-        """Both grids by one step: the background first (hole from the body grid extrapolated to the new
-        time), then the body grid (fringe from the background at the new time); ``step`` then advances the
-        turbulence model with the new velocities."""
-        self.background.step(dt)
-        self.body.step(dt)
-        self.t = self.body.t
-        self._psi_hist = [self._psi_hist[-1], (self.t, stream_function(self.body))]
-        self.n_steps += 1
-
-    @property
-    def total_force(self) -> np.ndarray:
-        """(F_x, F_y, M_z) on the body (all its polygons) over the last step, inertial axes, M_z about
-        the body's reference point (zeros without a body)."""
-        return self.body.total_force
-
-    last_force = total_force   # the pair's loads are always the sum over its polygons
+    def _body_stream_function(self) -> np.ndarray:
+        return stream_function(self.body)
 
     @property
     def n_cells(self) -> int:
