@@ -46,7 +46,8 @@ from bridge.cfd import (  # noqa: E402
 from bridge.cfd.body_fitted import BodyFittedPair  # noqa: E402
 from bridge.cfd.curvilinear import CurvilinearFlow, CurvilinearGrid, Farfield, polar_grid  # noqa: E402
 
-BANDS = {"cylinder40": (1.50, 1.58), "dfg_cd": (5.57, 5.59), "dfg_cl": (0.0104, 0.0110), "dfg2_cd": (3.22, 3.24),
+BANDS = {"cylinder40": (1.50, 1.58), "dfg_cd": (5.57, 5.59), "dfg_dp": (0.1172, 0.1176), "dfg_cl": (0.0104, 0.0110),
+         "dfg2_cd": (3.22, 3.24),
          "dfg2_cl": (0.99, 1.01), "dfg2_st": (0.295, 0.305)}
 
 
@@ -95,9 +96,9 @@ def couette(sizes=(32, 64, 128), t_end=3.0) -> dict:
     return {"case": "couette", "rows": rows}
 
 
-def cylinder(re=40.0, around=128, first=0.01, growth=1.08, outer=20.0, t_end=60.0) -> dict:
+def cylinder(re=40.0, around=128, first=0.01, growth=1.08, outer=20.0, t_end=60.0, cfl=0.5) -> dict:
     x, y = polar_grid(0.5, outer, around, first, growth)
-    flow = CurvilinearFlow(CurvilinearGrid(x, y), 1.0 / re, Stationary(), Farfield(1.0, 0.0))
+    flow = CurvilinearFlow(CurvilinearGrid(x, y), 1.0 / re, Stationary(), Farfield(1.0, 0.0), cfl=cfl)
     flow.set_uniform_flow(1.0)
     t0 = time.perf_counter()
     run(flow, t_end, [ProgressNote(f"cylinder Re {re:g}", t_end)])
@@ -108,14 +109,14 @@ def cylinder(re=40.0, around=128, first=0.01, growth=1.08, outer=20.0, t_end=60.
 
 
 def dfg(background=32, around=128, first=0.002, growth=1.1, outer=0.12, t_end=5.0, unsteady=False,
-        window=2.0) -> dict:
+        window=2.0, cfl=0.5) -> dict:
     d, h_ch, length, nu, umax = 0.1, 0.41, 2.2, 1e-3, (1.5 if unsteady else 0.3)
 
     def profile(y, t):
         return 4 * umax * y * (h_ch - y) / h_ch ** 2
 
     bc = BoundaryConditions(left="inflow", right="outflow", bottom="noslip", top="noslip", inflow_profile=profile)
-    cfg = FlowConfig(nu=nu, advection="vanleer", cfl=0.5, fourier=0.2, threads=2, bc=bc)
+    cfg = FlowConfig(nu=nu, advection="vanleer", cfl=cfl, fourier=0.2, threads=2, bc=bc)
     h = d / background
     grid = CartesianGrid.uniform(int(round(length / h)), int(round(h_ch / h)), (0.0, length), (0.0, h_ch))
     x, y = polar_grid(d / 2, outer, around, first, growth)
@@ -143,11 +144,17 @@ def dfg(background=32, around=128, first=0.002, growth=1.1, outer=0.12, t_end=5.
                 "St": d / (period * 2 * umax / 3), "periods_in_window": int(max(crossings.size - 1, 0)),
                 "band_c_D_max": BANDS["dfg2_cd"], "band_c_L_max": BANDS["dfg2_cl"], "band_St": BANDS["dfg2_st"]}
     last = t > t[-1] - 0.5
+    # the pressure difference between the cylinder's front and back points (x = 0.15 and 0.25 on y = 0.2): the
+    # wall pressure, linear in the angle between the wall faces' midpoints
+    xm = pair.body.grid.xmj[0]
+    ang = np.arctan2(xm[:, 1], xm[:, 0])
+    p_back, p_front = np.interp([0.0, math.pi], ang, pair.body.wall_pressure(), period=2 * math.pi)
+    dp = float(p_front - p_back)
     return {"case": "DFG 2D-1", "background_per_D": background, "around": around, "rings": pair.body.grid.nj,
             "first": first, "growth": growth, "outer_radius": outer, "cells": pair.n_cells, "t_end": t_end,
             "steps": pair.n_steps, "wall_s": time.perf_counter() - t0, "c_D": float(scale * fx[-1]),
-            "c_L": float(scale * fy[-1]), "c_D_change_last_0.5": float(scale * np.ptp(fx[last])),
-            "band_c_D": BANDS["dfg_cd"], "band_c_L": BANDS["dfg_cl"]}
+            "c_L": float(scale * fy[-1]), "delta_p": dp, "c_D_change_last_0.5": float(scale * np.ptp(fx[last])),
+            "band_c_D": BANDS["dfg_cd"], "band_c_L": BANDS["dfg_cl"], "band_delta_p": BANDS["dfg_dp"]}
 
 
 def main(argv=None) -> int:
@@ -161,16 +168,20 @@ def main(argv=None) -> int:
     ap.add_argument("--outer", type=float, default=None, help="outer radius (cylinder: 20 D; dfg: 0.12)")
     ap.add_argument("--background", type=int, default=32, help="dfg: background cells per diameter")
     ap.add_argument("--t-end", type=float, default=None)
+    ap.add_argument("--cfl", type=float, default=0.5, help="cylinder, dfg, dfg2: Courant number of the step (0.05-0.5)")
     ap.add_argument("--out", type=Path, default=Path("out/validate_body_fitted.json"))
     args = ap.parse_args(argv)
+    if not 0.05 <= args.cfl <= 0.5:
+        ap.error(f"--cfl: {args.cfl} not allowed; allowed: 0.05 .. 0.5")
     if args.case == "couette":
         row = couette(t_end=args.t_end or 3.0)
     elif args.case == "cylinder":
         row = cylinder(args.re, args.around, args.first or 0.01, args.growth or 1.08, args.outer or 20.0,
-                       args.t_end or 60.0)
+                       args.t_end or 60.0, cfl=args.cfl)
     else:
         row = dfg(args.background, args.around, args.first or 0.002, args.growth or 1.1, args.outer or 0.12,
-                  args.t_end or (8.0 if args.case == "dfg2" else 5.0), unsteady=args.case == "dfg2", window=args.window)
+                  args.t_end or (8.0 if args.case == "dfg2" else 5.0), unsteady=args.case == "dfg2", window=args.window,
+                  cfl=args.cfl)
     print(json.dumps(row, indent=1))
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(json.dumps(row, indent=1))
