@@ -50,12 +50,14 @@ THESIS_PITCH_RATE = 0.028 * 31.0 / 50.0   # thetadot_0 B / V (thesis 5.3)
 @dataclass(frozen=True)
 class ForcedCase:
     """One forced-motion run: ``dof`` "heave" or "pitch", the reduced frequencies K = w B / V of its
-    sine(s), their amplitudes (chords for heave, radians nose-up for pitch) and phases (radians)."""
+    sine(s), their amplitudes (chords for heave, radians nose-up for pitch) and phases (radians);
+    ``mean_angle``: the incidence (radians nose-up) the section moves about, in either dof."""
 
     dof: str
     reduced_frequencies: tuple[float, ...]
     amplitudes: tuple[float, ...]
     phases: tuple[float, ...] = ()
+    mean_angle: float = 0.0
 
     def __post_init__(self):
         if self.dof not in ("heave", "pitch"):
@@ -79,7 +81,7 @@ class ForcedCase:
         return cls(dof, (K,), (rate / K,))
 
     @classmethod
-    def multi_frequency(cls, dof: str, Ks: tuple[float, ...], rate: float) -> ForcedCase:
+    def multi_frequency(cls, dof: str, Ks: tuple[float, ...], rate: float, mean_angle: float = 0.0) -> ForcedCase:
         """A sum of sines at the reduced frequencies ``Ks`` (whole multiples of the lowest) in one run.
 
         Each sine gets the velocity amplitude ``rate`` of a single run: the moving immersed boundary's error
@@ -92,7 +94,7 @@ class ForcedCase:
         harmonic = [round(k / k0) for k in Ks]       # the sine's harmonic number m of the lowest frequency
         m_max = max(harmonic)
         phases = tuple(-math.pi * m * (m - 1) / m_max for m in harmonic)
-        return cls(dof, Ks, tuple(rate / k for k in Ks), phases)
+        return cls(dof, Ks, tuple(rate / k for k in Ks), phases, mean_angle)
 
     @property
     def fundamental(self) -> float:
@@ -119,10 +121,11 @@ class ForcedCase:
         """The rigid motion in the CFD frame (pitch nose-up = clockwise = -theta_z)."""
         from bridge.cfd import PrescribedMotion
 
+        a0 = self.mean_angle
         if self.dof == "heave":
-            return PrescribedMotion(lambda t: (0.0, self.displacement(t), 0.0),
+            return PrescribedMotion(lambda t: (0.0, self.displacement(t), -a0),
                                     lambda t: (0.0, self.rate(t), 0.0))
-        return PrescribedMotion(lambda t: (0.0, 0.0, -self.displacement(t)),
+        return PrescribedMotion(lambda t: (0.0, 0.0, -a0 - self.displacement(t)),
                                 lambda t: (0.0, 0.0, -self.rate(t)))
 
     def discarded_periods(self, q: Quality) -> int:
@@ -140,7 +143,8 @@ class ForcedCase:
 
     def excursion(self, radius: float) -> float:
         """Largest vertical travel of a point of the body (``radius``: its farthest point from the axis)."""
-        return sum(abs(a) for a in self.amplitudes) * (1.0 if self.dof == "heave" else radius)
+        tilt = abs(math.sin(self.mean_angle)) * radius
+        return sum(abs(a) for a in self.amplitudes) * (1.0 if self.dof == "heave" else radius) + tilt
 
     def progress(self, t: float, q: Quality) -> str:
         total = self.discarded_periods(q) + q.run.periods - q.run.discard_periods

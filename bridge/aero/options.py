@@ -39,6 +39,9 @@ Keys (all optional):
     wind_speed_m_s        the wind speed that sets the Reynolds number with turbulence = "sst" (default the
                           thesis's 50 m/s: Re = 1.05e8 for the Great Belt's 31 m); the derivatives are
                           per unit wind speed either way
+    mean_angle_deg        the incidence (degrees, nose-up) about which the section is moved in the forced runs
+                          (default 0; -10 to 10): derivatives about a mean angle of attack, such as the static
+                          twist a deck flutters about (docs/flutter.md, "The CFD's own check: free vibration")
     static_angles_deg     angles of attack (degrees, nose-up) at which the section is held still for its
                           static coefficients C_D, C_L, C_M, their slopes and the Strouhal number
                           (default -2, 0, 2; [] skips them); with aerodynamics = "cfd" they supply the
@@ -72,6 +75,7 @@ class AeroOptions:
     turbulence: str = "sst"
     wind_speed_m_s: float = 50.0
     sst_walls: str = "equilibrium"
+    mean_angle_deg: float = 0.0
 
     def __post_init__(self):
         check_flow_model(self.turbulence, self.sst_walls, USER_SST_WALLS)
@@ -110,6 +114,7 @@ class AeroOptions:
                 raise InputError("aero.reduced_velocities", values, "distinct values after rounding to the "
                                  f"largest ({top:g}) over whole numbers")
             object.__setattr__(self, "reduced_velocities", rv)
+        object.__setattr__(self, "mean_angle_deg", check_range("aero.mean_angle_deg", self.mean_angle_deg, -10.0, 10.0))
         check_range("aero.heave_rate", self.heave_rate, 0.0, 0.2, low_open=True)
         check_range("aero.pitch_rate", self.pitch_rate, 0.0, 0.2, low_open=True)
         if isinstance(self.checkpoint_every, bool) or not isinstance(self.checkpoint_every, int) \

@@ -37,7 +37,7 @@ from bridge.flutter.tables import DerivativeTable
 from bridge.results import write_dataset
 from bridge.stages import RunOptions, StageOutput
 
-__all__ = ["run", "AeroResult"]
+__all__ = ["run", "AeroResult", "scenario_preset"]
 
 
 @dataclass(frozen=True)
@@ -73,18 +73,27 @@ class AeroResult:
         return derivatives_from_frf(self.reduced_frequency, self.frf)
 
 
-def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
+def scenario_preset(scenario: Any, quality: str | None = None):
+    """The deck section a scenario's CFD moves and its preset (bridge.aero.presets.Quality): ``quality`` or the
+    scenario's ``[aero] quality``, on its grid, with the deck's own Reynolds number when the flow is turbulent.
+    Returns (section, quality)."""
     from bridge.cfd.sections import great_belt_section
 
     section = scenario.deck_section or great_belt_section()
     aopts: AeroOptions = scenario.aero or AeroOptions()
-    quality = options.quality or ("tiny" if options.quick else aopts.quality)
-    q = preset(quality, aopts.grid)
+    q = preset(quality or aopts.quality, aopts.grid)
     if aopts.turbulence != "laminar":   # the deck's own Reynolds number, with the SST model
         air = scenario.air
         nu_air = air.kinematic_viscosity_m2_s if air is not None else 1.48e-5
         q = q.with_(turbulence=aopts.turbulence, reynolds=aopts.wind_speed_m_s * section.chord_m / nu_air,
                     sst_walls=aopts.sst_walls)
+    return section, q
+
+
+def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
+    section, q = scenario_preset(scenario, options.quality or ("tiny" if options.quick else None))
+    aopts: AeroOptions = scenario.aero or AeroOptions()
+    quality = q.name
     poly = section_polygons(section)
     warning = preset_warnings(q, quality, section)
     if warning:
@@ -143,7 +152,8 @@ def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
     table = DerivativeTable(Ks, derivatives_from_frf(Ks, frf), source=f"cfd ({section.name}, {quality})",
                             provides=measured)
     sst = ", SST" if q.physics.turbulence == "sst" else ""
-    table.name = f"cfd ({section.name}, {quality}, Re {q.physics.reynolds:.3g}{sst})"
+    tilt = f", about {aopts.mean_angle_deg:g} deg" if aopts.mean_angle_deg else ""
+    table.name = f"cfd ({section.name}, {quality}, Re {q.physics.reynolds:.3g}{sst}{tilt})"
     model = table if static is None else WithLateral(table, static.quasi_steady())
     study, vc_error = grid_accuracy(section, aopts, quality, q.physics.reynolds)
     data = AeroResult(section.describe(), quality, q.physics.reynolds, cells, Ks, frf, stderr, model,
@@ -217,9 +227,10 @@ def _forced_cases(Ks: np.ndarray, aopts: AeroOptions) -> list[ForcedCase]:
     """The heave and pitch runs: one per reduced frequency (``excitation = "single"``), or one per degree of
     freedom moving at all of them at once (``"multi"``, :meth:`ForcedCase.multi_frequency`)."""
     rates = (("heave", aopts.heave_rate), ("pitch", aopts.pitch_rate))
+    a0 = math.radians(aopts.mean_angle_deg)
     if aopts.excitation == "multi":
-        return [ForcedCase.multi_frequency(dof, tuple(float(k) for k in Ks), rate) for dof, rate in rates]
-    return [ForcedCase(dof, (float(K),), (rate / float(K),)) for K in Ks for dof, rate in rates]
+        return [ForcedCase.multi_frequency(dof, tuple(float(k) for k in Ks), rate, a0) for dof, rate in rates]
+    return [ForcedCase(dof, (float(K),), (rate / float(K),), mean_angle=a0) for K in Ks for dof, rate in rates]
 
 
 def _static_results(recs, section, aopts: AeroOptions, options: RunOptions):
