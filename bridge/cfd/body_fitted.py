@@ -291,9 +291,7 @@ class BodyFittedPair(RigidPair, FlowBase):
         # the hole's ring: the outermost ring at least ``overlap`` background cells inside the outer ring
         depth = np.hypot(ogrid.x - ogrid.x[-1], ogrid.y - ogrid.y[-1]).min(axis=1)
         # and at least ``ring_overlap`` of the O-grid's own rings (default: half of them): the background must
-        # own the flow next to the O-grid's outer rings.  Measured on DFG 2D-1 (D/32 background, O-grid 128 x 15):
-        # the hole's edge 4 rings inside the outer one gave c_D 5.646, 8 rings 5.612 (band 5.57-5.59): the flow
-        # near the O-grid's outer boundary is the less accurate.
+        # own the flow next to the O-grid's outer rings, where the O-grid's cells are largest.
         ring_overlap = max(4, ogrid.nj // 2) if ring_overlap is None else int(ring_overlap)
         rings = np.nonzero((depth >= self.overlap * h) & (np.arange(ogrid.nj + 1) <= ogrid.nj - ring_overlap))[0]
         if rings.size == 0 or rings.max() < 1:
