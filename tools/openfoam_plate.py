@@ -1,4 +1,4 @@
-"""A body-fitted reference for the heaving or pitching thin plate: the same case in OpenFOAM (docs/aero.md).
+"""A body-fitted reference for the heaving or pitching thin plate: the same case in OpenFOAM (docs/validation.md).
 
     python tools/openfoam_plate.py --reduced-velocity 4 [--dof heave|pitch] [--edge-cell 0.0025]
                                    [--reynolds 1000] [--thickness 0.02] [--periods 6] [--procs 2]
@@ -6,7 +6,7 @@
     python tools/openfoam_plate.py --dof static --angle 2 [--duration 20] [--turbulence sst --reynolds 1e6]
 
 Why: the plate's flutter derivatives from our CFD miss Theodorsen's by 10-20 % at U/(fB) = 4 whatever the
-grid, step, domain or edges (docs/aero.md), and the question left was whether that is the viscous flow or
+grid, step, domain or edges (docs/validation.md), and the question left was whether that is the viscous flow or
 the immersed boundary.  This tool answers it with a code nobody here wrote and a method that has no
 immersed boundary: OpenFOAM's pimpleFoam (laminar, second order in space and time) on a block mesh fitted
 to the plate (square edges, cells clustered at its surfaces and edges), the whole mesh moving with the plate
@@ -16,7 +16,7 @@ transient, bridge.aero.frequency_response) as `python tools/validate_aero.py`.
 
 With ``--turbulence sst`` the same case runs OpenFOAM's kOmegaSST (the 2003 variant, as bridge.cfd.turbulence)
 with our freestream k and omega and Spalding's wall function for nut on the plate: a body-fitted reference for
-the SST runs of `python tools/validate_aero.py --turbulence sst` (docs/aero.md).
+the SST runs of `python tools/validate_aero.py --turbulence sst` (docs/validation.md, row 22).
 
 Heave is a rigid translation of the whole mesh (``oscillatingLinearMotion``).  Pitch rotates the plate's
 surface about its mid-chord and deforms the mesh around it (``displacementLaplacian`` with

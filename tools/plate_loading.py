@@ -1,4 +1,4 @@
-"""Where the thin plate held at an angle carries its lift: the pressure along its chord (docs/aero.md).
+"""Where the thin plate held at an angle carries its lift: the pressure along its chord (docs/validation.md).
 
     python tools/plate_loading.py [--angle 2] [--turbulence sst --reynolds 1e6] [--cells-per-chord 40]
                                   [--dy-over-dx 0.25] [--quality standard] [--duration 20]
@@ -6,7 +6,7 @@
                                   [--out out/plate_loading]
 
 Why: our SST plate's moment per angle is 18-24 % below OpenFOAM's body-fitted plate's while the lifts agree
-within a few per cent (docs/aero.md), so the two codes carry the lift at different places along the chord.
+within a few per cent (docs/validation.md), so the two codes carry the lift at different places along the chord.
 This tool holds the plate (``bridge.cfd.sections.FlatPlate``, 2 % thick) at ``--angle`` on the preset's overset
 pair (``bridge.aero.forced_motion.run_case`` with a ``StaticCase``), averages the body grid's pressure over the
 last quarter of the run, and reads it along the chord in the first cells above and below the plate that no

@@ -1,4 +1,4 @@
-"""Flutter derivatives of a thin flat plate from forced-motion CFD against Theodorsen's (docs/aero.md).
+"""Flutter derivatives of a thin flat plate from forced-motion CFD against Theodorsen's (docs/validation.md).
 
     python tools/validate_aero.py --quality standard --reduced-velocities 4 8 12 [--thickness 0.02]
                                   [--grid overset] [--turbulence sst --reynolds 1e6] [--threads N]
