@@ -166,7 +166,7 @@ def _parse_bridge(t: Table, name: str, description: str, source: str | None) -> 
 
 def _parse_optional_tables(t: Table, scenario: Scenario) -> Scenario:
     """[flutter], [section] and [modal] tables belong to the flutter package, [deck_section] to
-    bridge.cfd.sections and [aero] to bridge.aero; each validates its own."""
+    bridge.cfd.sections, [aero] to bridge.aero and [buffeting] to bridge.buffeting; each validates its own."""
     updates: dict[str, Any] = {}
     if "flutter" in t.data:
         from .flutter.options import FlutterOptions
@@ -189,6 +189,10 @@ def _parse_optional_tables(t: Table, scenario: Scenario) -> Scenario:
         from .aero.options import AeroOptions
 
         updates["aero"] = AeroOptions.from_mapping(t.raw("aero"), "aero")
+    if "buffeting" in t.data:
+        from .buffeting.options import BuffetingOptions
+
+        updates["buffeting"] = BuffetingOptions.from_mapping(t.raw("buffeting"), "buffeting")
     return replace(scenario, **updates) if updates else scenario
 
 

@@ -13,6 +13,7 @@ from .errors import InputError, check_range
 
 if TYPE_CHECKING:   # the tables other packages read and check (bridge.config); types only, no import at run time
     from .aero.options import AeroOptions
+    from .buffeting.options import BuffetingOptions
     from .cfd.sections import FlatPlate, PolygonSection, Rectangle, StreamlinedBox
     from .flutter.modal import ModalModel
     from .flutter.options import FlutterOptions
@@ -237,6 +238,7 @@ class Scenario:
     modal: ModalModel | None = None         # the [modal] table: modes given directly
     deck_section: FlatPlate | Rectangle | StreamlinedBox | PolygonSection | None = None   # [deck_section], aero stage
     aero: AeroOptions | None = None         # the [aero] table
+    buffeting: BuffetingOptions | None = None   # the [buffeting] table
 
     # Eq 4.7 ------------------------------------------------------------------------------------------
     @property

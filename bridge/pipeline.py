@@ -21,7 +21,7 @@ from .stages import STAGES, RunOptions, StageOutput, resolve_stage
 __all__ = ["plan_stages", "run_stages", "run_scenario", "default_stages", "stage_keys", "wants_cfd"]
 
 # Stages that only make sense for one kind of scenario.
-_KIND_STAGES = {"suspension_bridge": ("cable", "fem", "aero", "flutter"), "section": ("aero", "flutter"),
+_KIND_STAGES = {"suspension_bridge": ("cable", "fem", "aero", "flutter", "buffeting"), "section": ("aero", "flutter"),
                 "modal": ("aero", "flutter")}
 
 
@@ -33,8 +33,10 @@ def wants_cfd(scenario: Scenario) -> bool:
 
 def default_stages(scenario: Scenario) -> tuple[str, ...]:
     """The registered stages a scenario of this kind runs when none are named (the aero stage only when
-    the flutter stage is to use it)."""
-    return tuple(s for s in _KIND_STAGES.get(scenario.kind, ()) if s in STAGES and (s != "aero" or wants_cfd(scenario)))
+    the flutter stage is to use it; the buffeting stage only when the scenario has a [buffeting] table, so that
+    the main job stays as it was)."""
+    return tuple(s for s in _KIND_STAGES.get(scenario.kind, ()) if s in STAGES and (s != "aero" or wants_cfd(scenario))
+                 and (s != "buffeting" or scenario.buffeting is not None))
 
 
 def plan_stages(scenario: Scenario, requested: Iterable[str] | None) -> tuple[str, ...]:

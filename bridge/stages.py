@@ -103,14 +103,19 @@ CFD_KERNELS = ("kernels.cfd", "kernels.transport", "kernels.wall_law")
 # Registry; the order here is the run order.
 STAGES: dict[str, Stage] = {
     "cable": Stage("bridge.cable_stage:run", (), ("bridge.cable", "bridge.cable_stage"),
-                   ignores=("damping", "air", "flutter", "section", "modal")),
+                   ignores=("damping", "air", "flutter", "section", "modal", "buffeting")),
     "fem": Stage("bridge.structure.stage:run", ("cable",), ("bridge.structure", "kernels.fem"),
-                 ignores=("air", "flutter", "section", "modal")),
+                 ignores=("air", "flutter", "section", "modal", "buffeting")),
     # the deck's aerodynamics from forced-motion CFD: the section and the [aero] options only, so
     # bridges with one deck share it (the flutter stage reads it when [flutter] aerodynamics = "cfd")
     "aero": Stage("bridge.aero.stage:run", (), ("bridge.aero", "bridge.cfd", *CFD_KERNELS), shared=True,
-                  uses=("deck_section", "aero")),
-    "flutter": Stage("bridge.flutter.stage:run", ("fem", "aero"), ("bridge.flutter", "bridge.structure.plots")),
+                  uses=("deck_section", "aero", "air")),
+    "flutter": Stage("bridge.flutter.stage:run", ("fem", "aero"), ("bridge.flutter", "bridge.structure.plots"),
+                     ignores=("buffeting",)),
+    # the response to turbulent wind below the flutter speed, with the flutter stage's modes, aerodynamics and
+    # flutter speed; runs when asked for (--stages) or when the scenario has a [buffeting] table
+    "buffeting": Stage("bridge.buffeting.stage:run", ("fem", "aero", "flutter"),
+                       ("bridge.buffeting", "bridge.flutter")),
 }
 
 
