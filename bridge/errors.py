@@ -82,3 +82,16 @@ def check_range(key: str, value: float, low: float | None = None, high: float | 
         hi = "" if high is None else (f"< {high:g}" if high_open else f"<= {high:g}")
         raise InputError(key, value, "allowed range " + " and ".join(s for s in (lo, hi) if s))
     return v
+
+
+def check_table(where: str, mapping: object, allowed) -> None:
+    """A scenario table: a mapping whose keys are all among ``allowed`` (InputError naming ``where``, or
+    ``where.key`` and the keys allowed)."""
+    from collections.abc import Mapping
+
+    if not isinstance(mapping, Mapping):
+        raise InputError(where, mapping, "must be a table")
+    allowed = list(allowed)
+    for key in mapping:
+        if key not in allowed:
+            raise InputError(f"{where}.{key}", mapping[key], f"unknown key; allowed: {', '.join(allowed)}")

@@ -55,7 +55,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from bridge.aero.presets import GRIDS, QUALITY, USER_SST_WALLS, check_flow_model
-from bridge.errors import InputError, check_range
+from bridge.errors import InputError, check_range, check_table
 
 __all__ = ["AeroOptions"]
 
@@ -134,12 +134,7 @@ class AeroOptions:
 
     @classmethod
     def from_mapping(cls, mapping: Mapping[str, Any], where: str = "aero") -> AeroOptions:
-        if not isinstance(mapping, Mapping):
-            raise InputError(where, mapping, "must be a table")
-        allowed = cls.__dataclass_fields__
-        for key in mapping:
-            if key not in allowed:
-                raise InputError(f"{where}.{key}", mapping[key], f"unknown key; allowed: {', '.join(allowed)}")
+        check_table(where, mapping, cls.__dataclass_fields__)
         values = dict(mapping)
         for key in ("reduced_velocities", "static_angles_deg"):
             if key in values and isinstance(values[key], list):

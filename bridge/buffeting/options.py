@@ -36,7 +36,7 @@ from typing import Any
 
 from bridge.buffeting.admittance import Admittance
 from bridge.buffeting.wind import Turbulence
-from bridge.errors import InputError, check_range
+from bridge.errors import InputError, check_range, check_table
 from bridge.flutter.aerodynamics import QuasiSteady
 
 __all__ = ["BuffetingOptions", "STATIC_KEYS"]
@@ -107,12 +107,7 @@ class BuffetingOptions:
     def from_mapping(cls, mapping: Mapping[str, Any], where: str = "buffeting") -> BuffetingOptions:
         """Validate a ``[buffeting]`` table; unknown keys and bad values raise InputError naming ``where.key``,
         the value and what is allowed."""
-        if not isinstance(mapping, Mapping):
-            raise InputError(where, mapping, "must be a table")
-        allowed = [f.name for f in fields(cls)]
-        for key in mapping:
-            if key not in allowed:
-                raise InputError(f"{where}.{key}", mapping[key], f"unknown key; allowed: {', '.join(allowed)}")
+        check_table(where, mapping, [f.name for f in fields(cls)])
         values = dict(mapping)
         for key in ("admittance_reduced_frequency", "admittance_squared"):
             if key in values:

@@ -35,7 +35,7 @@ from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import Any
 
-from bridge.errors import InputError, check_range
+from bridge.errors import InputError, check_range, check_table
 from bridge.flutter.aerodynamics import (
     AerodynamicModel,
     DerivativeTable,
@@ -118,12 +118,7 @@ class FlutterOptions:
     @classmethod
     def from_mapping(cls, mapping: Mapping[str, Any], where: str = "flutter") -> FlutterOptions:
         """Validate a ``[flutter]`` table; unknown keys and bad values raise InputError naming ``where.key``."""
-        if not isinstance(mapping, Mapping):
-            raise InputError(where, mapping, "must be a table")
-        allowed = [f.name for f in fields(cls)]
-        for key in mapping:
-            if key not in allowed:
-                raise InputError(f"{where}.{key}", mapping[key], f"unknown key; allowed: {', '.join(allowed)}")
+        check_table(where, mapping, [f.name for f in fields(cls)])
         values = dict(mapping)
         if "derivatives_convention" in values:
             values["derivatives_convention"] = Convention.from_mapping(values["derivatives_convention"],

@@ -19,7 +19,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, fields
 from typing import Any
 
-from bridge.errors import InputError, check_range
+from bridge.errors import InputError, check_range, check_table
 from bridge.flutter.modal import ModalModel
 from bridge.flutter.options import AERODYNAMIC_MODELS
 
@@ -70,12 +70,7 @@ class SectionModel:
     def from_mapping(cls, mapping: Mapping[str, Any], where: str = "section") -> SectionModel:
         """Validate a ``[section]`` table; unknown/missing keys and bad values raise InputError naming
         ``where.key``, the value and the allowed range."""
-        if not isinstance(mapping, Mapping):
-            raise InputError(where, mapping, "must be a table")
-        names = [f.name for f in fields(cls)]
-        for key in mapping:
-            if key not in names:
-                raise InputError(f"{where}.{key}", mapping[key], f"unknown key; allowed: {', '.join(names)}")
+        check_table(where, mapping, [f.name for f in fields(cls)])
         for key in _POSITIVE:
             if key not in mapping:
                 raise InputError(f"{where}.{key}", None, "missing (required key)")
