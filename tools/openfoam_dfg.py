@@ -17,25 +17,30 @@ Why: ``python tools/validate_body_fitted.py dfg | dfg2`` runs the same cases in 
 over a Cartesian background); this tool gives a code nobody here wrote on a single body-fitted mesh, so that the
 two can be set side by side in accuracy and in wall time, run one after the other on the same machine.
 
-How: OpenFOAM's pimpleFoam (ESI v1912, laminar) on a blockMesh of 12 blocks: an O-grid ring of 4 blocks from
-the cylinder (arcs) to a square of side 2 D round it (straight sides), ``--around`` cells round the cylinder,
-the radial cells graded towards the wall (the first cell half the spacing along the wall, the last as large as the
-square's cells), and 8 Cartesian blocks filling the channel with cells of the square's spacing, growing by at
-most 3 % a cell to twice that size downstream of the square.  The radial count and its grading and the channel's
-cells all follow from ``--around`` (128: 14 686 cells, 184: 29 846).  The worst non-orthogonality, ~43 deg, is
-at the square's corners.  Second order in space and time: convection ``Gauss linearUpwind grad(U)`` (upwind-biased
-second order; everything else ``Gauss linear``, corrected), time ``backward`` (BDF2), the step adjusted to a
-Courant number of ``--max-co`` (default 0.5); PIMPLE with ``--outer`` outer correctors a step (default 2), each
-with 2 pressure correctors and 1 non-orthogonal corrector.  The outer correctors matter for 2D-2: in PISO mode
-(``--outer 1``) the splitting error lifted c_L,max on 14 686 cells to 1.138 at Co 1, 1.067 at Co 0.5 and 1.032 at
-Co 0.25, where 2 outer correctors at Co 0.5 (the cost of PISO at Co 0.25) gave 0.994.  The inflow is
-``fixedProfile`` (the parabola as a polynomial in y at the face centres); the flow starts from rest.  The
-coefficients come from the ``forceCoeffs`` function object (lRef = D, Aref = D x the mesh's depth, magUInf =
-Ubar) every step.
+How: OpenFOAM's pimpleFoam (ESI v1912, laminar) on a blockMesh of 12 blocks: an O-grid ring of 4 blocks from the
+cylinder (arcs) to a square of side 2 D round it (straight sides), ``--around`` cells round the cylinder, the radial
+cells graded towards the wall (the first cell half the spacing along the wall, the last as large as the square's
+cells, on the lines to the middles of the square's sides; both 1.8 times that on its diagonals, the ring's radial
+lines being longer there), and 8 Cartesian blocks filling the channel with cells of the square's spacing, growing by
+at most 3 % a cell to twice that size downstream of the square.  The radial count and its grading and the channel's
+cells all follow from ``--around`` (128: 14 686 cells, 184: 29 846).  The worst non-orthogonality, ~43 deg, is at the
+square's corners.  Second order in space and time: convection ``Gauss linearUpwind grad(U)`` (upwind-biased second
+order; everything else ``Gauss linear``, corrected), time ``backward`` (BDF2), the step adjusted to a Courant number
+of ``--max-co`` (default 0.5); PIMPLE with ``--outer`` outer correctors a step (default 2), each with 2 pressure
+correctors and 1 non-orthogonal corrector.  The outer correctors matter for 2D-2: in PISO mode (``--outer 1``) the
+splitting error lifted c_L,max on 14 686 cells to 1.138 at Co 1, 1.067 at Co 0.5 and 1.032 at Co 0.25, where 2 outer
+correctors at Co 0.5 (the cost of PISO at Co 0.25) gave 0.994.  The inflow is ``fixedProfile`` (the parabola as a
+polynomial in y at the face centres); the flow starts from rest.  The coefficients come from the ``forceCoeffs``
+function object (lRef = D, Aref = D x the mesh's depth, magUInf = Ubar) every step.
 2D-1 runs to ``--t-end`` (default 10); c_D, c_L at the end and their change over the last time unit (the steady
 state's check) are reported.  2D-2 runs to ``--t-end`` (default 8) and takes c_D,max and c_L,max over the last
 2 time units and St from c_L's period (the mean spacing of its upward crossings of its mean), as
 validate_body_fitted.py's dfg2 does.
+
+Results here (defaults, --procs 2): 2D-1 on 14 686 cells c_D 5.5769, c_L 0.01073 (2 910 steps, 63 s); 2D-2 on
+14 686 cells c_D,max 3.2298, c_L,max 0.9936, St 0.2979 (13 929 steps, 440 s), on 29 846 cells 3.2296, 0.9940,
+0.2999 (20 043 steps, ~1 700 s): all in the bands.  The times are pimpleFoam's own on a 2-core machine shared with
+other runs, so only indicative.
 
 Needs OpenFOAM (Debian's package ``openfoam``: ``apt-get install openfoam``); not a dependency of the project.
 Writes the case to ``--out`` (default out/openfoam_dfg/<case>_n<around>), runs blockMesh, checkMesh and
@@ -88,7 +93,8 @@ CONVECTION = "Gauss linearUpwind grad(U)"
 
 def ring_cells(around: int) -> tuple[int, float, float]:
     """The O-grid's radial cells: their count, the expansion from the wall to the square, and the first cell's
-    height, along the ring's shortest radial line (to the middle of a side of the square, length a - D/2).  The
+    height, along the ring's shortest radial line (to the middle of a side of the square, length a - D/2; the
+    cells on the other radial lines are as much larger as the line is longer, 1.8 times on the diagonals).  The
     first cell is WALL_ASPECT times the spacing along the wall, the last as large as the square's cells; the count
     is the one whose geometric series best fits the line."""
     line = HALF_SQUARE - D / 2
