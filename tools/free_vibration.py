@@ -45,19 +45,12 @@ from bridge.aero.free_vibration import (  # noqa: E402
 from bridge.aero.presets import QUALITY, build_flow, section_polygons  # noqa: E402
 from bridge.aero.stage import scenario_preset  # noqa: E402
 from bridge.errors import InputError  # noqa: E402
+from bridge.flutter.stage import air_density  # noqa: E402
 from bridge.stages import code_digest  # noqa: E402
 
 
 class Grown(Exception):
     """The motion outgrew what the grid makes room for: the growth is established."""
-
-
-def air_density(sc) -> float:
-    if sc.section.air_density_kg_m3 is not None:
-        return sc.section.air_density_kg_m3
-    if sc.flutter is not None and getattr(sc.flutter, "air_density_kg_m3", None) is not None:
-        return sc.flutter.air_density_kg_m3
-    return sc.air.density_kg_m3 if sc.air is not None else 1.225
 
 
 def derivative_route(sc, quality: str, cache: Path | None, summary: Path | None) -> dict:
@@ -79,13 +72,8 @@ def derivative_route(sc, quality: str, cache: Path | None, summary: Path | None)
             "multimode_critical_speed_m_s": s.get("flutter.multimode_critical_speed_m_s")}
 
 
-def release_run(sc, q, speed: float, args, cache: Path | None) -> dict:
+def release_run(q, polys, structure: SpringSection, speed: float, args, cache: Path | None) -> dict:
     """One speed: the record of heave and pitch after the release (cached by its inputs and the code)."""
-    section = sc.section
-    rho = air_density(sc)
-    structure = SpringSection.at_speed(section, speed, rho)
-    deck, _ = scenario_preset(sc, q.name)
-    polys = section_polygons(deck)
     twist = -math.radians(args.twist_deg)   # nose up = clockwise
     if args.about_zero:   # held level, the mean loads preloaded into the springs, released with a pitch rate
         case = ReleaseCase(twist_rad=0.0, hold=args.hold, kick_rate=structure.pitch_omega * twist, preload=True)
@@ -127,7 +115,7 @@ def release_run(sc, q, speed: float, args, cache: Path | None) -> dict:
     return {"history": history, "wall_s": wall, "cells": int(flow.n_cells), "grown": grown, "cached": False}
 
 
-def fit(run_record: dict, structure: SpringSection, speed: float, chord: float, skip: float) -> dict:
+def fit(run_record: dict, speed: float, chord: float, skip: float) -> dict:
     h = run_record["history"]
     t = h[:, 0]
     # the first pitch period holds the flow's start-up; a record cut short by growth keeps its last 3/4
@@ -210,11 +198,12 @@ def main(argv=None) -> int:
     except InputError as err:
         print(f"error: {err}", file=sys.stderr)
         return 2
+    polys, rho = section_polygons(deck), air_density(sc)
     results, records = [], []
     for v in speeds:
-        rec = release_run(sc, q, v, args, cache)
-        structure = SpringSection.at_speed(sc.section, v, air_density(sc))
-        results.append(fit(rec, structure, v, sc.section.deck_width_m, 2 * math.pi / structure.pitch_omega))
+        structure = SpringSection.at_speed(sc.section, v, rho)
+        rec = release_run(q, polys, structure, v, args, cache)
+        results.append(fit(rec, v, sc.section.deck_width_m, 2 * math.pi / structure.pitch_omega))
         records.append(rec)
         r = results[-1]
         cached = ", cached" if rec["cached"] else ""

@@ -50,6 +50,9 @@ _TURBULENCE = {"spectrum": "spectrum", "turbulence_intensity_u": "intensity_u",
                "coherence_decay_w": "decay_w"}
 
 
+_DEFAULT = Turbulence()   # the turbulence defaults live in bridge.buffeting.wind; the table's keys take them
+
+
 def _integer(key: str, value: Any, low: int) -> int:
     if isinstance(value, bool) or not isinstance(value, int) or value < low:
         raise InputError(key, value, f"an integer >= {low}")
@@ -60,13 +63,13 @@ def _integer(key: str, value: Any, low: int) -> int:
 class BuffetingOptions:
     """Validated ``[buffeting]`` table (module docstring)."""
 
-    spectrum: str = "kaimal"
-    turbulence_intensity_u: float = 0.11
-    turbulence_intensity_w: float | None = None
-    length_scale_u_m: float = 180.0
-    length_scale_w_m: float | None = None
-    coherence_decay_u: float = 10.0
-    coherence_decay_w: float = 6.5
+    spectrum: str = _DEFAULT.spectrum
+    turbulence_intensity_u: float = _DEFAULT.intensity_u
+    turbulence_intensity_w: float | None = _DEFAULT.intensity_w
+    length_scale_u_m: float = _DEFAULT.length_scale_u_m
+    length_scale_w_m: float | None = _DEFAULT.length_scale_w_m
+    coherence_decay_u: float = _DEFAULT.decay_u
+    coherence_decay_w: float = _DEFAULT.decay_w
     admittance: str = "sears"
     admittance_reduced_frequency: tuple[float, ...] = ()
     admittance_squared: tuple[float, ...] = ()

@@ -32,7 +32,7 @@ from bridge.flutter.options import FlutterOptions
 from bridge.results import write_dataset
 from bridge.stages import RunOptions, StageOutput
 
-__all__ = ["run", "FlutterStageResult", "LateralEffect"]
+__all__ = ["run", "FlutterStageResult", "LateralEffect", "air_density"]
 
 QUICK_SPEED_STEPS = 40
 
@@ -92,7 +92,9 @@ def _modes(scenario: Any, upstream: dict) -> tuple[ModalModel, str]:
     raise InputError("flutter", None, "needs modes: run the fem stage or give [modal] data")
 
 
-def _air_density(scenario: Any, fopts: FlutterOptions) -> float:
+def air_density(scenario: Any, fopts: FlutterOptions | None = None) -> float:
+    """The air density of the flutter stage (module doc): a [section]'s, else [flutter]'s, else [air]'s."""
+    fopts = fopts or scenario.flutter or FlutterOptions()
     section = scenario.section if scenario.kind == "section" else None
     for value in (getattr(section, "air_density_kg_m3", None), fopts.air_density_kg_m3,
                   scenario.air.density_kg_m3):
@@ -116,7 +118,7 @@ def options_and_aerodynamics(scenario: Any, upstream: dict) -> tuple[FlutterOpti
 def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
     fopts, aero = options_and_aerodynamics(scenario, upstream)
     modal, source = _modes(scenario, upstream)
-    rho = _air_density(scenario, fopts)
+    rho = air_density(scenario, fopts)
     n_speed = min(fopts.speed_steps, QUICK_SPEED_STEPS) if options.quick else fopts.speed_steps
     kw = dict(min_speed_m_s=fopts.min_speed_m_s, n_speed=n_speed)
 
