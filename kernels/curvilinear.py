@@ -1,10 +1,11 @@
 """Warp kernels of the body-fitted solver (bridge/cfd/curvilinear.py): the line solves of its implicit
 diffusion, one thread per grid line (storage [j, i]: ring j from the wall, i around the body, periodic).
 
-``line_solve_rings``: along each line i, (I - c L_j) x = r with L_j the ring-to-ring diffusion
-    (L_j x)_j = k_lo[j] (x[j-1] - x[j]) + k_hi[j] (x[j+1] - x[j]) (k: c nu alpha / area, already times c),
-  x[-1] and x[nj] zero (the boundary values are in r); on ring 0 the wall face's second-order gradient
-  w0 (x0 - x_w) + w1 (x1 - x_w) replaces k_lo (x0 - x_w).
+``line_solve_rings``: along each line i, (I + diag - c L_j) x = r with L_j the ring-to-ring diffusion and
+  upwind advection (L_j x)_j = k_lo[j] (x[j-1] - x[j]) + k_hi[j] (x[j+1] - x[j]) (k: c nu alpha / area and
+  the upwind fluxes' c F / area, already times c) and ``diag`` what the advection's conservative form adds to
+  the diagonal; x[-1] and x[nj] zero (the boundary values are in r); on ring 0 the wall face's second-order
+  gradient w0 (x0 - x_w) + w1 (x1 - x_w) replaces k_lo (x0 - x_w).
 ``line_solve_around``: along each ring j, (I - c L_i) x = r with L_i the diffusion around the ring,
   periodic: (L_i x)_i = k_m[i] (x[i-1] - x[i]) + k_p[i] (x[i+1] - x[i]); a cyclic tridiagonal system,
   solved by the Thomas algorithm with the Sherman-Morrison correction.
@@ -15,19 +16,20 @@ import warp as wp
 
 @wp.kernel
 def line_solve_rings(k_lo: wp.array2d(dtype=wp.float64), k_hi: wp.array2d(dtype=wp.float64),
+                     diag: wp.array2d(dtype=wp.float64),
                      w0: wp.array(dtype=wp.float64), w1: wp.array(dtype=wp.float64),
                      r: wp.array2d(dtype=wp.float64), nj: int,
                      cp: wp.array2d(dtype=wp.float64), x: wp.array2d(dtype=wp.float64)):
     i = wp.tid()
     one = wp.float64(1.0)
     # ring 0: diagonal 1 + k_hi + k_lo w0, upper -(k_hi - k_lo w1)
-    d = one + k_hi[0, i] + k_lo[0, i] * w0[i]
+    d = one + k_hi[0, i] + k_lo[0, i] * w0[i] + diag[0, i]
     up = -(k_hi[0, i] - k_lo[0, i] * w1[i])
     cp[0, i] = up / d
     x[0, i] = r[0, i] / d
     for j in range(1, nj):
         lo = -k_lo[j, i]
-        dj = one + k_lo[j, i] + k_hi[j, i]
+        dj = one + k_lo[j, i] + k_hi[j, i] + diag[j, i]
         m = dj - lo * cp[j - 1, i]
         cp[j, i] = -k_hi[j, i] / m
         x[j, i] = (r[j, i] - lo * x[j - 1, i]) / m

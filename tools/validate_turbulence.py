@@ -4,6 +4,7 @@
     python tools/validate_turbulence.py channel --re-tau 395 # fully developed channel vs the log law
     python tools/validate_turbulence.py plate --nx 200 --t-end 2  # TMR flat plate (about 25 min)
     python tools/validate_turbulence.py ibplate --dy 4e-4 --t-end 2.5  # the same plate immersed, wall function
+    python tools/validate_turbulence.py ogplate --t-end 2.5  # the same plate on the body-fitted wall (17 min)
                                                  [--walls blended|equilibrium|resolved]  # other wall treatments
 
 decay: homogeneous turbulence at rest (no walls: F1 = 0, the outer constants), k0 = 0.01, omega0 = 1,
@@ -30,6 +31,12 @@ and ``--dy`` high at the plate (stretching by 1.1 beyond 4 cells of it), both si
 on the upper side comes from the wall law through the velocity of the first u-face row more than 1.5
 dy above the wall (as the wall function sees it); reported: c_f at x = 0.97 against TMR's resolved
 0.00271-0.00272, its y+, and the drag force beside the friction integrated from c_f(x) on both sides.
+ogplate: the same plate on the body-fitted wall (bridge/cfd/curvilinear_sst.py: SST resolved to the wall on an
+O-grid): a plate 2 long and ``--thickness`` thick (0.02: 1 % of its length) with semi-elliptic ends (axes 20
+thicknesses by one), the leading edge at x = 0, in a uniform stream (the O-grid's outer boundary ``--outer`` from
+the wall, default 1 as TMR's top boundary; the freestream's k and omega there, which decay on their way to the
+plate), ``--around`` wall nodes, the first cell ``--dy1`` high growing by ``--growth``. Reported as plate's: c_f
+at x = 0.97008 on the upper side against TMR's 0.00271-0.00272.
 Results are appended to ``--out`` as JSON lines.
 """
 
@@ -263,6 +270,85 @@ def plate_report(nx, dy1, growth, t_end):
             "x": x.tolist(), "cf": cf.tolist(), "profile_y+": yp.tolist(), "profile_U+": up.tolist()}
 
 
+def plate_outline(thickness: float, length: float = 2.0, n_end: int = 60) -> np.ndarray:
+    """Counter-clockwise outline of a flat plate from x = 0 to ``length`` (the flat part from one end's
+    length, 2 thicknesses, to ``length``) with semi-elliptic ends (nose radius thickness / 8), the leading edge
+    at x = 0."""
+    a, b = 2.0 * thickness, 0.5 * thickness
+    th = np.linspace(0.0, np.pi, n_end + 1)
+    phi = np.linspace(0.0, 0.5 * np.pi, n_end // 2 + 1)
+    # the trailing end from (length + a, 0) up to (length, b); the leading end from (a, b) round to (a, -b)
+    back_top = np.column_stack([length + a * np.cos(phi), b * np.sin(phi)])
+    front = np.column_stack([a - a * np.sin(th), b * np.cos(th)])
+    back_bottom = np.column_stack([length + a * np.cos(phi[::-1]), -b * np.sin(phi[::-1])])
+    return np.vstack([back_top, front, back_bottom[:-1]])
+
+
+def ogplate(around=600, dy1=5e-6, growth=1.12, thickness=0.02, outer=1.0, t_end=3.0, reynolds=5e6, cfl=0.8,
+            progress=None):
+    """TMR's flat plate on the body-fitted wall (module doc): returns the flow, its model, x and c_f along the
+    upper side, c_f at x = 0.97 every 0.25 L/U and the grid's quality."""
+    from bridge.cfd.curvilinear import CurvilinearFlow, CurvilinearGrid, Farfield
+    from bridge.cfd.curvilinear_sst import CurvilinearSST
+    from bridge.cfd.motion import Stationary
+    from bridge.cfd.ogrid import o_grid
+
+    nu = 1.0 / reynolds
+    og = o_grid(plate_outline(thickness), around, dy1, growth, outer, corner_refinement=20.0)
+    grid = CurvilinearGrid(og.x, og.y)
+    flow = CurvilinearFlow(grid, nu, Stationary(), Farfield(1.0, 0.0), cfl=cfl)
+    flow.set_uniform_flow(1.0, 0.0)
+    k_inf = 9e-9 / 0.2 ** 2                # TMR: k = 9e-9 a^2 at M = 0.2, in units of U^2
+    model = CurvilinearSST(flow, k_inf, k_inf / (0.009 * nu))   # TMR: nu_t / nu = 0.009 in the freestream
+    xm, ym = grid.xmj[0, :, 0], grid.xmj[0, :, 1]
+    upper = (ym > 0) & (xm > 0.2) & (xm < 1.9)
+    order = np.argsort(xm[upper])
+
+    def skin_friction():   # c_f = 2 nu du/dn along the upper side (tangent: +x there)
+        su, _ = flow.wall_shear(flow.t)
+        return xm[upper][order], (2 * nu * su[upper])[order]
+
+    history, next_mark = [], 0.25
+    while flow.t < t_end:
+        flow.step()
+        if flow.t >= next_mark:
+            x, cf = skin_friction()
+            history.append((float(flow.t), float(np.interp(0.97008, x, cf))))
+            next_mark += 0.25
+            if not np.isfinite(cf).all():
+                raise FloatingPointError(f"ogplate: non-finite skin friction at t = {flow.t}")
+            if progress:
+                progress(flow.t, t_end, history[-1][1], flow.n_steps)
+    x, cf = skin_friction()
+    return flow, model, x, cf, history, og.quality()
+
+
+def ogplate_report(around, dy1, growth, thickness, outer, t_end, cfl):
+    t0 = time.perf_counter()
+
+    def progress(t, t_end, cf, n):
+        print(f"  t = {t:.3f} of {t_end:g}: c_f(0.97) = {cf:.6f} ({n} steps, {time.perf_counter() - t0:.0f} s)",
+              file=sys.stderr, flush=True)
+
+    flow, model, x, cf, history, quality = ogplate(around, dy1, growth, thickness, outer, t_end, cfl=cfl,
+                                                    progress=progress)
+    g = flow.grid
+    cf97 = float(np.interp(0.97008, x, cf))
+    u_tau = np.sqrt(0.5 * cf97)
+    i = int(np.argmin(np.abs(g.xmj[0, :, 0] - 0.97008) + 10 * (g.xmj[0, :, 1] < 0)))
+    yp = model.wall_distance[:, i] * u_tau * 5e6
+    up = flow.u[:, i] / u_tau
+    band = (yp >= 30) & (yp <= 300)
+    log = np.log(yp) / KAPPA + B
+    return {"case": "SST flat plate (TMR), body-fitted wall", "around": g.ni, "rings": g.nj, "dy1": dy1,
+            "growth": growth, "thickness": thickness, "outer": outer, "t_end": t_end, "cfl": cfl,
+            "steps": flow.n_steps, "wall_s": time.perf_counter() - t0, "cf_0.97": cf97, "band": [0.00271, 0.00272],
+            "first_cell_y+_0.97": float(yp[0]), "cf_0.97_history": history, "grid_quality": quality.summary(),
+            "log_law_deviation_30_300": float(np.max(np.abs(up[band] / log[band] - 1))) if band.any() else None,
+            "nx": g.ni, "ny": g.nj,
+            "x": x.tolist(), "cf": cf.tolist(), "profile_y+": yp.tolist(), "profile_U+": up.tolist()}
+
+
 def _plot_plate(r, stem: Path) -> None:
     """c_f(x) and the profile at x = 0.97 in wall units, as a PNG beside the results."""
     import matplotlib
@@ -289,7 +375,11 @@ def _plot_plate(r, stem: Path) -> None:
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("case", choices=["decay", "channel", "plate", "ibplate"])
+    ap.add_argument("case", choices=["decay", "channel", "plate", "ibplate", "ogplate"])
+    ap.add_argument("--around", type=int, default=600, help="ogplate: wall nodes around the plate")
+    ap.add_argument("--thickness", type=float, default=0.02, help="ogplate: the plate's thickness (length 2)")
+    ap.add_argument("--outer", type=float, default=1.0, help="ogplate: the O-grid's reach from the wall")
+    ap.add_argument("--cfl", type=float, default=0.8, help="ogplate: the convective Courant number")
     ap.add_argument("--dy", type=float, default=4e-4, help="ibplate: cell height at the plate (4e-4: y+ ~ 100)")
     ap.add_argument("--walls", choices=KOmegaSST.BODY_WALLS, default="function",
                     help="ibplate: Spalding's wall function everywhere (default), blended with the linear profile "
@@ -316,6 +406,9 @@ def main(argv=None):
             ap.error(f"--dy: {args.dy} not allowed; allowed: 5e-5 .. 5e-3")
         r = ibplate(args.dy, t_end=args.t_end, body_walls=args.walls,
                     progress=lambda t, t_end: print(f"  t = {t:.2f} of {t_end:g}", file=sys.stderr, flush=True))
+    elif args.case == "ogplate":
+        r = ogplate_report(args.around, args.dy1, args.growth, args.thickness, args.outer, args.t_end, args.cfl)
+        _plot_plate(r, Path(args.out).with_name(f"ogplate_{args.around}"))
     else:
         r = plate_report(args.nx, args.dy1, args.growth, args.t_end)
         _plot_plate(r, Path(args.out).with_name(f"plate_nx{args.nx}"))

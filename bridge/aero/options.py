@@ -21,7 +21,8 @@ Keys (all optional):
                           moves); "single": one grid, the section an immersed body moving on it (with "sst"
                           its forces jitter as the faces change class: docs/cfd.md, "Immersed boundary");
                           "body_fitted": an O-grid graded from the section's wall over the same background
-                          (bridge/cfd/body_fitted.py; laminar and one outline only so far: docs/cfd.md,
+                          (bridge/cfd/body_fitted.py; one outline only so far; with "sst" its wall is
+                          resolved, the first cell at y+ ~ 1, whatever sst_walls says: docs/cfd.md,
                           "Body-fitted grid")
     turbulence            "sst" (default): the k-omega SST model (2003 variant) with Spalding's wall function on
                           the section, at the deck's Reynolds number Re = wind_speed_m_s B / nu_air ([air]
@@ -83,9 +84,6 @@ class AeroOptions:
 
         if self.grid not in GRIDS:
             raise InputError("aero.grid", self.grid, f"one of {', '.join(GRIDS)}")
-        if self.grid == "body_fitted" and self.turbulence != "laminar":
-            raise InputError("aero.turbulence", self.turbulence, "with grid = \"body_fitted\": \"laminar\" only (the "
-                             "SST model's wall treatment on the body-fitted grid is not written yet)")
 
         if self.quality not in QUALITY:
             raise InputError("aero.quality", self.quality, f"one of {', '.join(QUALITY)}")

@@ -311,15 +311,14 @@ def _overset_flow(q: Quality, polygons: list, case, threads: int | None):
 
 def _body_fitted_flow(q: Quality, polygons: list, case, threads: int | None):
     """The section in a body-fitted O-grid that moves with it over the overset pair's background
-    (bridge.cfd.body_fitted.BodyFittedPair): laminar; one outline (appendages are not resolved yet)."""
-    from bridge.cfd import CartesianGrid
-    from bridge.cfd.body_fitted import BodyFittedPair
+    (bridge.cfd.body_fitted.BodyFittedPair): one outline (appendages are not resolved yet); with SST its wall
+    resolved (bridge.cfd.body_fitted.BodyFittedSST), the first cell at y+ ~ 1 unless the preset says otherwise."""
+    from bridge.cfd import CartesianGrid, freestream_turbulence
+    from bridge.cfd.body_fitted import BodyFittedPair, BodyFittedSST
     from bridge.cfd.curvilinear import CurvilinearGrid
+    from bridge.cfd.curvilinear_sst import first_height_for
     from bridge.cfd.ogrid import o_grid
 
-    if q.physics.turbulence != "laminar":
-        raise InputError("aero.turbulence", q.physics.turbulence, "with grid = \"body_fitted\": \"laminar\" only "
-                         "(the SST model's wall treatment on the body-fitted grid is not written yet)")
     if len(polygons) > 1:
         raise InputError("aero.grid", "body_fitted", f"one outline only: this section has {len(polygons)} parts (the "
                          "body-fitted grid does not resolve railings or screens yet); use grid = \"overset\"")
@@ -328,7 +327,8 @@ def _body_fitted_flow(q: Quality, polygons: list, case, threads: int | None):
     x, y = outline[:, 0], outline[:, 1]
     perimeter = float(np.hypot(np.diff(x, append=x[0]), np.diff(y, append=y[0])).sum())
     n_around = int(round(perimeter * (g.around_per_chord or 2.0 * g.cells_per_chord)))
-    first = g.first_height or 0.1 / g.cells_per_chord
+    sst = q.physics.turbulence == "sst"
+    first = g.first_height or (first_height_for(q.physics.reynolds) if sst else 0.1 / g.cells_per_chord)
     H = g.background_coarsening / g.cells_per_chord
     margin = max(g.body_margin, 8 * H)   # the hole (4 background cells inside the O-grid) leaves rings to overlap
     try:
@@ -346,4 +346,6 @@ def _body_fitted_flow(q: Quality, polygons: list, case, threads: int | None):
         threads = 1 if background.nx * background.ny < 20_000 else 2
     pair = BodyFittedPair(background, ogrid, _flow_config(q, threads), case.motion())
     pair.set_uniform_flow(1.0)
+    if sst:
+        BodyFittedSST(pair, *freestream_turbulence(1.0, 1.0 / q.physics.reynolds))
     return pair

@@ -32,8 +32,10 @@ from .flow import LAMINAR, FlowBase
 from .grids import GHOST
 from .overset import RigidPair
 from .time_stepping import FlowConfig, Simulation, SubstepHook
+from .transport import advance_pair
+from .turbulence import KOmegaSST, bilinear
 
-__all__ = ["OGridLocator", "BodyFittedPair"]
+__all__ = ["OGridLocator", "BodyFittedPair", "BodyFittedSST"]
 
 
 def _lagrange4(f: np.ndarray) -> np.ndarray:
@@ -397,6 +399,8 @@ class BodyFittedPair(RigidPair, FlowBase):
     def checkpoint_arrays(self) -> dict[str, np.ndarray]:
         out = {f"background/{f}": a for f, a in self.background.state.arrays().items()}
         out.update({f"body/{f}": a for f, a in self.body.checkpoint_arrays().items()})
+        if self.turbulence is not LAMINAR:   # the background's k and omega are in its state already
+            out.update({f"turbulence/{f}": a for f, a in self.turbulence.body.state_arrays().items()})
         out["psi_times"] = np.array([t for t, _ in self._psi_hist])
         for k, (_, psi) in enumerate(self._psi_hist):
             out[f"psi_{k}"] = psi
@@ -407,8 +411,81 @@ class BodyFittedPair(RigidPair, FlowBase):
         self.background.t, self.background.n_steps = float(t), int(n_steps)
         self.body.restore_arrays({k[5:]: v for k, v in arrays.items() if k.startswith("body/")}, t, n_steps)
         self.t, self.n_steps = float(t), int(n_steps)
+        if self.turbulence is not LAMINAR:
+            self.turbulence.body.restore({k[11:]: v for k, v in arrays.items() if k.startswith("turbulence/")})
         times = np.atleast_1d(arrays["psi_times"])
         self._psi_hist = [(float(tk), np.asarray(arrays[f"psi_{k}"])) for k, tk in enumerate(times)]
         self._hole_hook._t = None
         self.body.outer._cache = {}
         self.body.outer._values(self.t)   # the boundary values at the step's start, from the background now
+
+
+class BodyFittedSST:
+    """SST-2003 on a :class:`BodyFittedPair`: the background's ``KOmegaSST`` and the O-grid's
+    ``CurvilinearSST`` (its wall resolved), coupled as the velocity is (a turbulence model of bridge/cfd/flow.py,
+    advanced by the pair after both velocity steps):
+    * background: the cells whose centres lie inside the hole's ring are held at the O-grid's k and omega
+      (bilinear between its cell centres; those inside the body at the freestream's, which nothing reads);
+      its wall distance counts the body's wall at its starting pose (off by the motion's amplitude, far from
+      the wall: it only enters the blending functions there);
+    * O-grid: its two ghost rings take the background's k and omega of the step's end (bilinear), at the
+      places the ghost cells have then: the background's own solution, outside the hole.
+    k and omega are scalars, the same in either frame."""
+
+    name = "sst"
+
+    def __init__(self, pair: BodyFittedPair, k_inf: float, omega_inf: float):
+        from types import SimpleNamespace
+
+        from .curvilinear_sst import CurvilinearSST
+
+        self.pair = pair
+        og = pair.body.grid
+        wall = SimpleNamespace(vertices=np.column_stack([og.x[0], og.y[0]]))
+        self.background = KOmegaSST(pair.background, k_inf, omega_inf, "resolved",
+                                    far_walls=[(wall, pair.motion.pose(pair.t))], attach=False)
+        self.body = CurvilinearSST(pair.body, k_inf, omega_inf, ghosts=self._ghosts, attach=False)
+        self.k_inf, self.omega_inf = float(k_inf), float(omega_inf)
+        pair.use_turbulence(self)
+
+    def _ghosts(self, t: float):
+        """The O-grid's ghost rings' k and omega from the background's at their places at t."""
+        pair, g = self.pair, self.pair.body.grid
+        grid = pair.background.grid
+        X, Y = pair.to_background(g.xg, g.yg, t)
+        return tuple(bilinear(s.interior(), grid.x_centres, grid.y_centres, X, Y)
+                     for s in (self.background.k, self.background.omega))
+
+    def hole_cells(self, t: float):
+        """Background cells (storage J, I) whose centres lie inside the hole's ring at t, their body
+        coordinates, and which of them lie inside the body."""
+        pair, g = self.pair, GHOST
+        grid, og = pair.background.grid, pair.body.grid
+        X, Y = pair.to_background(og.x[pair.j_hole], og.y[pair.j_hole], t)
+        i = np.nonzero((grid.x_centres >= X.min()) & (grid.x_centres <= X.max()))[0]
+        j = np.nonzero((grid.y_centres >= Y.min()) & (grid.y_centres <= Y.max()))[0]
+        JJ, II = np.meshgrid(j, i, indexing="ij")
+        xi, eta = pair.to_body(grid.x_centres[II], grid.y_centres[JJ], t)
+        pts = np.column_stack([xi.ravel(), eta.ravel()])
+        inside = pair._hole_path.contains_points(pts).reshape(xi.shape)
+        solid = pair._body_path.contains_points(pts).reshape(xi.shape)[inside]
+        return (JJ[inside] + g, II[inside] + g), xi[inside], eta[inside], solid
+
+    def advance(self, dt: float) -> None:
+        """k and omega of both grids over the step both flows have just taken (the background first)."""
+        bg, body, t = self.background, self.body, self.pair.t
+        bg.update()
+        (J, I), xi, eta, solid = self.hole_cells(t)
+        if J.size:
+            k, w = np.full(J.size, self.k_inf), np.full(J.size, self.omega_inf)
+            jf, if_ = self.pair.locator.locate(xi[~solid], eta[~solid])
+            ok = np.isfinite(jf)
+            fluid = np.nonzero(~solid)[0][ok]
+            k[fluid] = self.pair.locator.cells(body.k, jf[ok], if_[ok])
+            w[fluid] = self.pair.locator.cells(body.omega, jf[ok], if_[ok])
+            bg.hold(J, I, k, w)
+        advance_pair(bg.k, bg.omega, dt)
+        body.transport(dt)
+
+    def stable_dt(self) -> float:
+        return min(self.background.stable_dt(), self.body.stable_dt())

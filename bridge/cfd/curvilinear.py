@@ -50,6 +50,8 @@ from .flow import LAMINAR, FlowBase
 
 __all__ = ["CurvilinearGrid", "CurvilinearFlow", "Farfield", "polar_grid"]
 
+IMPLICIT_ASPECT = 10.0   # cells flatter than this (along the wall / across) advect across the rings implicitly
+
 
 def _rot(theta: float) -> np.ndarray:
     c, s = math.cos(theta), math.sin(theta)
@@ -135,12 +137,24 @@ class CurvilinearGrid:
         above_x = np.vstack([cx, self.xg[:1]])
         above_y = np.vstack([cy, self.yg[:1]])
         self.alpha_j, self.beta_j = self._coefficients(self.Sj, above_x - below_x, above_y - below_y, tx, ty)
-        self.wall_distance = np.hypot(cx - self.xmj[0, :, 0], cy - self.xmj[0, :, 1])   # (nj, ni), approx.
+        # each cell's distance from its column's wall face, along the face's normal: at a convex corner the grid
+        # lines fan out, and the centres of the first rings lie beside their wall face rather than above it, where
+        # the distance to its midpoint made the first two rings' distances nearly equal and the one-sided
+        # gradients below (and the wall's pressure and shear) divide by their difference
+        nx_, ny_ = self.Sj[0, :, 0], self.Sj[0, :, 1]
+        length = np.hypot(nx_, ny_)
+        self.wall_distance = ((cx - self.xmj[0, :, 0]) * nx_ + (cy - self.xmj[0, :, 1]) * ny_) / length   # (nj, ni)
         # the wall face's normal gradient from a quadratic through the wall and the first two rings (second
         # order: the half-cell difference alone leaves the wall's shear first order):
         # dq/dn d0 = w0 (q0 - q_w) + w1 (q1 - q_w)
         d0, d1 = self.wall_distance[0], self.wall_distance[1]
         self.wall_w0, self.wall_w1 = d1 / (d1 - d0), -d0 * d0 / (d1 * (d1 - d0))
+        # the j-faces whose advection is implicit: between two cells flatter than IMPLICIT_ASPECT (along the wall
+        # over across), where the flow crossing the thin cells would set the step (module doc)
+        along = 0.5 * (np.hypot(*self.Sj[:-1].transpose(2, 0, 1)) + np.hypot(*self.Sj[1:].transpose(2, 0, 1)))
+        aspect = along * along / self.area
+        self.implicit_j = np.zeros((nj + 1, ni), dtype=bool)
+        self.implicit_j[1:nj] = np.minimum(aspect[1:], aspect[:-1]) > IMPLICIT_ASPECT
         self.n_cells = nj * ni
 
     @staticmethod
@@ -198,6 +212,7 @@ class CurvilinearFlow(FlowBase):
         self.outer.attach(self)
         self.turbulence = LAMINAR
         nj, ni = grid.nj, grid.ni
+        self.set_eddy_viscosity(np.zeros((nj, ni)))
         self.u = np.zeros((nj, ni))
         self.v = np.zeros((nj, ni))
         self.p = np.zeros((nj, ni))
@@ -332,8 +347,10 @@ class CurvilinearFlow(FlowBase):
         """q with the wall's reflection below ring 0 and the two ghost rings above: (nj + 3, ni), rows -1 .. nj+1."""
         return np.vstack([2 * q_wall_face[None] - q[:1], q, ghosts])
 
-    def _advection(self, q, ext, Fi_rel, Fj_rel):
-        """div(q (u - u_g)) per cell area: van Leer's limited upwind face values along the grid lines."""
+    def _advection(self, q, ext, Fi_rel, Fj_rel, implicit: str = "skip"):
+        """div(q (u - u_g)) per cell area: van Leer's limited upwind face values along the grid lines; the
+        implicit j-faces (``grid.implicit_j``) left out (``implicit="skip"``: the line solve carries them) or
+        first-order upwind (``"upwind"``: the residual of a delta form whose line solve has their Jacobian)."""
         # i-faces: minus side i-1, plus side i
         qm1, q0 = np.roll(q, 1, axis=1), q
         qm2, qp1 = np.roll(q, 2, axis=1), np.roll(q, -1, axis=1)
@@ -347,6 +364,11 @@ class CurvilinearFlow(FlowBase):
         dnj = self._limited(hi, lo, hi2)
         fj = np.zeros_like(Fj_rel)
         fj[1:] = Fj_rel[1:] * np.where(Fj_rel[1:] > 0, upj, dnj)   # the wall face carries no relative flux
+        imp = self.grid.implicit_j
+        if implicit == "skip":
+            fj[imp] = 0.0
+        else:
+            fj[imp] = (Fj_rel * np.where(Fj_rel > 0, ext[:-2], ext[1:-1]))[imp]   # rings f-1 and f of face f
         return (np.roll(fi, -1, axis=1) - fi + fj[1:] - fj[:-1]) / self.grid.area
 
     @staticmethod
@@ -357,51 +379,123 @@ class CurvilinearFlow(FlowBase):
             r = np.where(np.abs(dq) > 1e-300, (qu - quu) / np.where(np.abs(dq) > 1e-300, dq, 1.0), 0.0)
         return qu + 0.5 * _van_leer(r) * dq
 
-    def _diffusion_parts(self, q, q_wall_face, q_wall_node, ghosts):
-        """The diffusion nu lap q per cell area in three parts: every face's cross term (beta, explicit),
-        the alpha terms of the i-faces (around each ring) and of the j-faces (ring to ring, the wall and
-        outer faces with their boundary values), both implicit; each as its value now."""
+    def set_eddy_viscosity(self, nu_t: np.ndarray) -> None:
+        """The eddy viscosity of the cells (nj, ni), from a turbulence model: the momentum's diffusivity becomes
+        nu + nu_t on the faces (the mean of the two cells; the wall face nu alone, the outer face's extrapolated
+        from the last two rings), and its stress nu_t (grad u + grad u^T) (the transpose part explicit)."""
         g = self.grid
+        nu_t = np.asarray(nu_t, dtype=np.float64)
+        self.nu_t = nu_t
+        e1 = np.hypot(g.xmj[-1, :, 0] - g.xc[-1], g.xmj[-1, :, 1] - g.yc[-1])
+        e2 = np.hypot(g.xc[-1] - g.xc[-2], g.yc[-1] - g.yc[-2])
+        outer = np.maximum(nu_t[-1] + (nu_t[-1] - nu_t[-2]) * e1 / e2, 0.0)   # extrapolated along the grid lines
+        self.nu_i = self.nu + 0.5 * (nu_t + np.roll(nu_t, 1, axis=1))
+        self.nu_j = self.nu + np.vstack([np.zeros((1, g.ni)), 0.5 * (nu_t[1:] + nu_t[:-1]), outer[None]])
+        self._turbulent = bool(np.any(nu_t != 0.0))
+
+    def cell_gradient(self, q, q_wall_face, q_outer_face) -> tuple[np.ndarray, np.ndarray]:
+        """grad q at the cell centres by Green-Gauss: interior faces the mean of their two cells, the wall and
+        outer faces the values given ((ni,) each)."""
+        g = self.grid
+        qi = 0.5 * (q + np.roll(q, 1, axis=1))
+        qj = np.vstack([q_wall_face[None], 0.5 * (q[1:] + q[:-1]), q_outer_face[None]])
+        out = []
+        for k in (0, 1):
+            fi = qi * g.Si[..., k]
+            fj = qj * g.Sj[..., k]
+            out.append((np.roll(fi, -1, axis=1) - fi + fj[1:] - fj[:-1]) / g.area)
+        return out[0], out[1]
+
+    def diffusion_parts(self, q, gam_i, gam_j, q_wall_face, q_wall_node, ghosts, w0=None, w1=None):
+        """div(Gamma grad q) per cell area in three parts, Gamma on the faces (gam_i (nj, ni), gam_j (nj + 1, ni)):
+        every face's cross term (beta, explicit), the alpha terms of the i-faces (around each ring) and of the
+        j-faces (ring to ring, the wall and outer faces with their boundary values), both implicit; each as its
+        value now.  The wall face's normal gradient w0 (q0 - q_w) + w1 (q1 - q_w) (default: the quadratic
+        through the wall and the first two rings)."""
+        g = self.grid
+        w0 = g.wall_w0 if w0 is None else w0
+        w1 = g.wall_w1 if w1 is None else w1
         # node values: wall nodes given; interior nodes the mean of four cells; outer nodes with ghost ring 1
         ext = np.vstack([q, ghosts[:1]])                              # rings 0 .. nj (nj: ghost)
         four = 0.25 * (ext[:-1] + np.roll(ext[:-1], 1, axis=1) + ext[1:] + np.roll(ext[1:], 1, axis=1))
         nodes = np.vstack([q_wall_node[None], four])                  # (nj + 1, ni): node (j, i)
         # i-faces: alpha (q_i - q_{i-1}) + beta (node (j+1, i) - node (j, i))
-        fi_normal = g.alpha_i * (q - np.roll(q, 1, axis=1))
-        fi_cross = g.beta_i * (nodes[1:] - nodes[:-1])
+        fi_normal = gam_i * g.alpha_i * (q - np.roll(q, 1, axis=1))
+        fi_cross = gam_i * g.beta_i * (nodes[1:] - nodes[:-1])
         # j-faces: cross terms beta (node (j, i+1) - node (j, i)); normal alpha (above - below)
-        fj_cross = g.beta_j * (np.roll(nodes, -1, axis=1) - nodes)
+        fj_cross = gam_j * g.beta_j * (np.roll(nodes, -1, axis=1) - nodes)
         below = np.vstack([q_wall_face[None], q])
         above = np.vstack([q, ghosts[:1]])
         fj_normal = g.alpha_j * (above - below)
-        fj_normal[0] = g.alpha_j[0] * (g.wall_w0 * (q[0] - q_wall_face) + g.wall_w1 * (q[1] - q_wall_face))
-        cross = self.nu * (np.roll(fi_cross, -1, axis=1) - fi_cross + fj_cross[1:] - fj_cross[:-1]) / g.area
-        around = self.nu * (np.roll(fi_normal, -1, axis=1) - fi_normal) / g.area
-        rings = self.nu * (fj_normal[1:] - fj_normal[:-1]) / g.area
+        fj_normal[0] = g.alpha_j[0] * (w0 * (q[0] - q_wall_face) + w1 * (q[1] - q_wall_face))
+        fj_normal *= gam_j
+        cross = (np.roll(fi_cross, -1, axis=1) - fi_cross + fj_cross[1:] - fj_cross[:-1]) / g.area
+        around = (np.roll(fi_normal, -1, axis=1) - fi_normal) / g.area
+        rings = (fj_normal[1:] - fj_normal[:-1]) / g.area
         return cross, around, rings
 
-    def _implicit_solve(self, rhs, c):
-        """(I - c L_i)(I - c L_j) x = rhs: the implicit diffusion around the rings, then across them (an
-        approximate factorisation, second order in time as Crank-Nicolson's), one line solve per grid line
-        (kernels/curvilinear.py); x is zero on the wall and the ghost ring (an increment)."""
+    def _transpose_stress(self, u, v, wall_face, ghosts):
+        """div(nu_t (grad u)^T) per cell area, both components (explicit; zero while laminar): the cells'
+        gradients averaged to the faces, nu_t on them as the momentum's (the wall face none)."""
+        g = self.grid
+        outer = [0.5 * (q[-1] + gh[0]) for q, gh in zip((u, v), ghosts, strict=True)]
+        (ux, uy), (vx, vy) = (self.cell_gradient(q, wf, o) for q, wf, o in zip((u, v), wall_face, outer, strict=True))
+        nt_i, nt_j = self.nu_i - self.nu, self.nu_j - self.nu
+        out = []
+        for a, b in ((ux, vx), (uy, vy)):   # row x: (du/dx, dv/dx) . S; row y: (du/dy, dv/dy) . S
+            fa = lambda q: 0.5 * (q + np.roll(q, 1, axis=1))  # noqa: E731
+            ja = lambda q: np.vstack([q[:1], 0.5 * (q[1:] + q[:-1]), q[-1:]])  # noqa: E731
+            fi = nt_i * (fa(a) * g.Si[..., 0] + fa(b) * g.Si[..., 1])
+            fj = nt_j * (ja(a) * g.Sj[..., 0] + ja(b) * g.Sj[..., 1])
+            out.append((np.roll(fi, -1, axis=1) - fi + fj[1:] - fj[:-1]) / g.area)
+        return out
+
+    def line_solve(self, rhs, k_m, k_p, k_lo, k_hi, diag, w0, w1):
+        """(I - L_i)(I + diag - L_j) x = rhs with the implicit coefficients given (already times the step): around
+        the rings, then across them (kernels/curvilinear.py); x is zero on the wall and the ghost ring (an
+        increment)."""
         import warp as wp
 
         from kernels import curvilinear as _kc
 
-        g = self.grid
-        nj, ni = g.nj, g.ni
-        scale = c * self.nu / g.area
-        k_m = scale * g.alpha_i
-        k_p = scale * np.roll(g.alpha_i, -1, axis=1)
-        k_lo = scale * g.alpha_j[:-1]
-        k_hi = scale * g.alpha_j[1:]
+        nj, ni = self.grid.nj, self.grid.ni
         arr = lambda a: wp.array(np.ascontiguousarray(a), dtype=wp.float64, device="cpu")  # noqa: E731
         w = self._line_buffers
         wp.launch(_kc.line_solve_around, dim=nj, device="cpu",
                   inputs=[arr(k_m), arr(k_p), arr(rhs), ni, w["cp_i"], w["y"], w["z"], w["x_i"]])
         wp.launch(_kc.line_solve_rings, dim=ni, device="cpu",
-                  inputs=[arr(k_lo), arr(k_hi), self._w0, self._w1, w["x_i"], nj, w["cp_j"], w["x_j"]])
+                  inputs=[arr(k_lo), arr(k_hi), arr(diag), w0, w1, w["x_i"], nj, w["cp_j"], w["x_j"]])
         return w["x_j"].numpy().copy()
+
+    def implicit_coefficients(self, c, gam_i, gam_j, Fj_rel):
+        """The line solves' coefficients (k_m, k_p, k_lo, k_hi, diag) of c div(Gamma grad q)'s alpha terms and of
+        the implicit j-faces' first-order upwind advection by the relative fluxes Fj_rel (the cell's outflow
+        F+ q_P + F- q_E on its upper face, less the same on its lower face)."""
+        g = self.grid
+        scale = c / g.area
+        k_i = scale * g.alpha_i * gam_i
+        k_j = g.alpha_j * gam_j
+        F = np.where(g.implicit_j, Fj_rel, 0.0)
+        Fp, Fm = np.maximum(F, 0.0), np.minimum(F, 0.0)
+        k_lo = scale * (k_j[:-1] + Fp[:-1])
+        k_hi = scale * (k_j[1:] - Fm[1:])
+        diag = scale * (F[1:] - F[:-1])
+        return k_i, scale * np.roll(g.alpha_i * gam_i, -1, axis=1), k_lo, k_hi, diag
+
+    def upwind_implicit(self, q, Fj_rel):
+        """The implicit j-faces' first-order upwind advection of q per cell area (the part of the line solve's
+        operator, applied to q)."""
+        F = np.where(self.grid.implicit_j, Fj_rel, 0.0)
+        rings = np.vstack([q[:1], q, q[-1:]])   # the wall and outer faces carry no implicit flux
+        f = F * np.where(F > 0, rings[:-1], rings[1:])
+        return (f[1:] - f[:-1]) / self.grid.area
+
+    def _implicit_solve(self, rhs, c, Fj_rel):
+        """(I - c L_i)(I - c L_j) x = rhs: the implicit diffusion around the rings, then across them with the
+        implicit j-faces' advection (an approximate factorisation, second order in time as Crank-Nicolson's), one
+        line solve per grid line (kernels/curvilinear.py); x is zero on the wall and the ghost ring (an
+        increment)."""
+        return self.line_solve(rhs, *self.implicit_coefficients(c, self.nu_i, self.nu_j, Fj_rel), self._w0, self._w1)
 
     # --- the step ---------------------------------------------------------------------------------
     def set_uniform_flow(self, u_inf: float = 1.0, v_inf: float = 0.0) -> None:
@@ -426,11 +520,12 @@ class CurvilinearFlow(FlowBase):
         Fj_rel = self.Fj - self._grid_flux(t, g.xmj, g.Sj)
         Fj_rel[0] = 0.0
         om = self.frame_velocity(t)[2]
+        tr = self._transpose_stress(u, v, (wfu, wfv), (gu, gv)) if self._turbulent else (0.0, 0.0)
         out = []
-        for q, wf, wn, gh, frame in ((u, wfu, wnu, gu, om * v), (v, wfv, wnv, gv, -om * u)):
+        for q, wf, wn, gh, frame, extra in ((u, wfu, wnu, gu, om * v, tr[0]), (v, wfv, wnv, gv, -om * u, tr[1])):
             adv = self._advection(q, self._ring_values(q, wf, gh), Fi_rel, Fj_rel)
-            cross, around, rings = self._diffusion_parts(q, wf, wn, gh)
-            out.append((cross - adv + frame, around + rings, (wf, gh[0])))
+            cross, around, rings = self.diffusion_parts(q, self.nu_i, self.nu_j, wf, wn, gh)
+            out.append((cross - adv + frame + extra, around + rings, (wf, gh[0])))
         return out
 
     def _project(self, us, vs, t_new, dt, accumulate=True):
@@ -470,13 +565,15 @@ class CurvilinearFlow(FlowBase):
         g = self.grid
         t = self.t
         Fi_rel = np.abs(self.Fi - self._grid_flux(t, g.xmi, g.Si))
-        Fj_rel = np.abs(self.Fj - self._grid_flux(t, g.xmj, g.Sj))
+        Fj_rel = np.where(g.implicit_j, 0.0, np.abs(self.Fj - self._grid_flux(t, g.xmj, g.Sj)))
         rate = (Fi_rel + np.roll(Fi_rel, -1, axis=1) + Fj_rel[1:] + Fj_rel[:-1]) / (2 * g.area)
         conv = float(rate.max()) / self.cfl
-        # the explicit cross-derivative diffusion (skewed cells only; the rest of the diffusion is implicit)
-        cross = (np.abs(g.beta_i) + np.abs(np.roll(g.beta_i, -1, axis=1)) + np.abs(g.beta_j[1:])
-                 + np.abs(g.beta_j[:-1]))
-        visc = float((self.nu * cross / g.area).max()) / self.fourier
+        # the explicit cross-derivative diffusion (skewed cells only; the rest of the diffusion is implicit); the
+        # wall face's differences the wall's own values, given (at a corner's fan its beta is large)
+        bj = np.abs(g.beta_j * self.nu_j)
+        bj[0] = 0.0
+        cross = (np.abs(g.beta_i * self.nu_i) + np.abs(np.roll(g.beta_i * self.nu_i, -1, axis=1)) + bj[1:] + bj[:-1])
+        visc = float((cross / g.area).max()) / self.fourier
         return 1.0 / (conv + visc)
 
     def _advance_flow(self, dt: float) -> None:
@@ -498,19 +595,21 @@ class CurvilinearFlow(FlowBase):
         (wfu1, wfv1), _, (gu1, gv1) = self._boundary(t_new)
         gpx = (self._Gcx @ self.p.ravel()).reshape(self.u.shape)
         gpy = (self._Gcy @ self.p.ravel()).reshape(self.u.shape)
-        wall_k = self.nu * g.alpha_j[0] * (g.wall_w0 + g.wall_w1) / g.area[0]
-        top_k = self.nu * g.alpha_j[-1] / g.area[-1]
+        Fj_rel = self.Fj - self._grid_flux(t, g.xmj, g.Sj)   # the implicit j-faces' advection: by the fluxes now
+        Fj_rel[0] = 0.0
+        wall_k = self.nu_j[0] * g.alpha_j[0] * (g.wall_w0 + g.wall_w1) / g.area[0]
+        top_k = self.nu_j[-1] * g.alpha_j[-1] / g.area[-1]
         new = []
         olds = (None, None) if self._q_old is None else self._q_old
         for q, q_old, e, (_, impl, (wf0, gh0)), gp, wf1, gh1 in (
                 (self.u, olds[0], ex[0], terms[0], gpx, wfu1, gu1[0]),
                 (self.v, olds[1], ex[1], terms[1], gpy, wfv1, gv1[0])):
-            rhs = c * (e + impl) - c * gp        # the implicit terms with their boundary values now ...
+            rhs = c * (e + impl - self.upwind_implicit(q, Fj_rel)) - c * gp   # the implicit terms now ...
             rhs[0] += c * wall_k * (wf1 - wf0)   # ... moved to the step's end
             rhs[-1] += c * top_k * (gh1 - gh0)
             if q_old is not None:
                 rhs += (w * w / (1 + w)) / a0 * (q - q_old)
-            new.append(q + self._implicit_solve(rhs, c))
+            new.append(q + self._implicit_solve(rhs, c, Fj_rel))
         self._H, self._dt_old, self._q_old = H, dt, (self.u.copy(), self.v.copy())
         self._project(new[0], new[1], t_new, c)
         self.t, self.n_steps, self.last_dt = t_new, self.n_steps + 1, dt
@@ -576,6 +675,8 @@ class CurvilinearFlow(FlowBase):
         if self._H is not None:
             out.update(H_u=self._H[0], H_v=self._H[1], dt_old=np.array(self._dt_old), u_old=self._q_old[0],
                        v_old=self._q_old[1])
+        if self.turbulence is not LAMINAR:
+            out.update({f"turbulence/{name}": a for name, a in self.turbulence.state_arrays().items()})
         return out
 
     def restore_arrays(self, arrays: dict[str, np.ndarray], t: float, n_steps: int) -> None:
@@ -589,3 +690,5 @@ class CurvilinearFlow(FlowBase):
             self._dt_old = float(arrays["dt_old"])
             self._q_old = (np.asarray(arrays["u_old"]).copy(), np.asarray(arrays["v_old"]).copy())
         self.t, self.n_steps = float(t), int(n_steps)
+        if self.turbulence is not LAMINAR:
+            self.turbulence.restore({k[11:]: v for k, v in arrays.items() if k.startswith("turbulence/")})

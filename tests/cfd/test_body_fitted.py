@@ -12,8 +12,9 @@ from bridge.aero.forced_motion import ForcedCase
 from bridge.aero.options import AeroOptions
 from bridge.aero.presets import build_flow, preset, section_polygons
 from bridge.cfd import BoundaryConditions, CartesianGrid, Flow, FlowConfig, PrescribedMotion, Stationary, run
-from bridge.cfd.body_fitted import BodyFittedPair, node_stream_function
+from bridge.cfd.body_fitted import BodyFittedPair, BodyFittedSST, node_stream_function
 from bridge.cfd.curvilinear import CurvilinearFlow, CurvilinearGrid, Farfield, polar_grid
+from bridge.cfd.curvilinear_sst import first_height_for
 from bridge.cfd.sections import FlatPlate, StreamlinedBox
 from bridge.errors import InputError
 
@@ -72,8 +73,11 @@ def test_a_settled_flow_does_not_depend_on_the_time_step():
     assert abs(cds[0] / cds[1] - 1) < 3e-4, cds
 
 
-def test_a_body_fitted_case_resumes_bit_for_bit():
+@pytest.mark.parametrize("turbulence", ["laminar", "sst"])
+def test_a_body_fitted_case_resumes_bit_for_bit(turbulence):
     q = preset("tiny", "body_fitted")
+    if turbulence == "sst":
+        q = q.with_(turbulence="sst", reynolds=1e5)
     polys = section_polygons(FlatPlate(1.0, 0.04))
     case = ForcedCase.thesis("pitch", 1.0)
     a = build_flow(q, polys, case)
@@ -89,13 +93,21 @@ def test_a_body_fitted_case_resumes_bit_for_bit():
 
 
 def test_what_the_body_fitted_grid_cannot_do_yet_is_refused_by_name():
-    with pytest.raises(InputError, match="aero.turbulence.*laminar"):
-        AeroOptions(grid="body_fitted")   # the default turbulence is SST
-    assert AeroOptions(grid="body_fitted", turbulence="laminar").grid == "body_fitted"
     q = preset("tiny", "body_fitted")
     two_parts = section_polygons(StreamlinedBox(railings=True))
     assert len(two_parts) > 1
     with pytest.raises(InputError, match="aero.grid.*one outline"):
         build_flow(q, two_parts, ForcedCase.thesis("heave", 1.0))
-    with pytest.raises(InputError, match="aero.turbulence"):
-        build_flow(q.with_(turbulence="sst", reynolds=1e7), two_parts[:1], ForcedCase.thesis("heave", 1.0))
+
+
+def test_sst_on_the_body_fitted_pair_resolves_the_wall():
+    """With SST the preset's O-grid starts at y+ ~ 1 (White's turbulent plate at the case's Reynolds number) and
+    both grids carry the model; the sst_walls option does not apply (the wall is resolved)."""
+    assert AeroOptions(grid="body_fitted").turbulence == "sst"
+    q = preset("tiny", "body_fitted").with_(turbulence="sst", reynolds=1e6)
+    flow = build_flow(q, section_polygons(FlatPlate(1.0, 0.04))[:1], ForcedCase.thesis("heave", 1.0))
+    assert isinstance(flow.turbulence, BodyFittedSST) and flow.turbulence.name == "sst"
+    first = 2 * np.median(flow.turbulence.body.wall_distance[0])   # (less at the corners, nearer the fan's node)
+    assert first == pytest.approx(first_height_for(1e6), rel=0.05)
+    run(flow, 0.2)
+    assert flow.turbulence.body.nu_t.max() > 0 and np.isfinite(flow.total_force).all()

@@ -87,3 +87,38 @@ def test_the_cylinder_at_re_40_meets_the_published_drag():
     run(flow, 80.0)
     cd = 2 * flow.total_force[0]
     assert 1.50 <= cd <= 1.58, cd
+
+
+def _variable_viscosity_couette(ni: int, slope: float = 2.0):
+    """Couette flow as above with an eddy viscosity nu_t = slope (r - R1) (zero on the inner wall, as a turbulence
+    model's): the torque r^2 tau_r_theta is the same on every circle, tau_r_theta = (nu + nu_t) r d(u/r)/dr, so
+    u/r = OMEGA (1 - I(r) / I(R2)), I(r) = int_R1^r ds / ((nu + nu_t(s)) s^3) (the full stress: with nu_t in
+    nu_t lap u alone the answer differs at O(1))."""
+    from scipy.integrate import quad
+
+    def omega_r(r):
+        f = lambda s: 1.0 / ((NU + slope * (s - R1)) * s ** 3)  # noqa: E731
+        return OMEGA * (1 - quad(f, R1, r, epsabs=1e-14)[0] / quad(f, R1, R2, epsabs=1e-14)[0])
+
+    def exact(x, y):
+        r = np.hypot(x, y)
+        ut = r * np.vectorize(omega_r)(r)
+        return -ut * y / r, ut * x / r
+
+    class Outer(ExactOuter):
+        def ghost_velocity(self, t):
+            return exact(self.flow.grid.xg, self.flow.grid.yg)
+
+    x, y = polar_grid(R1, R2, ni, (R2 - R1) / (ni // 4), 1.0)
+    motion = PrescribedMotion(lambda t: (0.0, 0.0, OMEGA * t), lambda t: (0.0, 0.0, OMEGA))
+    flow = CurvilinearFlow(CurvilinearGrid(x, y), NU, motion, Outer(), cfl=0.5)
+    flow.set_eddy_viscosity(slope * (np.hypot(flow.grid.xc, flow.grid.yc) - R1))
+    flow.set_uniform_flow(0.0)
+    run(flow, 1.5)
+    ue, ve = exact(flow.grid.xc, flow.grid.yc)
+    return max(np.abs(flow.u - ue).max(), np.abs(flow.v - ve).max()), np.abs(ue).max()
+
+
+def test_an_eddy_viscosity_enters_the_full_stress_at_second_order():
+    (e1, scale), (e2, _) = _variable_viscosity_couette(32), _variable_viscosity_couette(64)
+    assert e2 < 0.01 * scale and math.log2(e1 / e2) > 1.8, (e1, e2, scale)

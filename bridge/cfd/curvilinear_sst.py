@@ -1,0 +1,203 @@
+"""The k-omega SST model (2003 variant; its equations are in bridge/cfd/turbulence.py) on the body-fitted
+O-grid (bridge/cfd/curvilinear.py), with the wall resolved: the first cell in the viscous sublayer.
+
+Why its own discretisation: the O-grid's operators are its own (contravariant fluxes, the nine-point face
+gradient, the thin wall cells whose normal diffusion must be implicit), so k and omega are carried by the
+same operators as the velocity: van Leer's limited upwinding relative to the grid, diffusion with the full
+metric, the faces' diffusivity the mean of their two cells'.
+
+Wall (Menter 1994, AIAA J. 32: 1598; as NASA TMR's "SST" page recommends): k = 0 and
+omega = 60 nu / (beta_1 d_1^2) on the wall face, d_1 the first cell centre's distance from the wall; the
+wall face's gradient the half-cell difference (omega ~ 1/d^2 next to a wall: a quadratic through the first
+two rings would be worse than none).  Wall functions are not offered: the O-grid is graded from the wall, so
+y+ ~ 1 costs tens of rings even at Re 1e8 (``first_height_for``).
+
+Time step: one step per flow step, after it (segregated, as the Cartesian model), in delta form,
+  (D - dt L_i) D^-1 (D - dt L_j) dq = dt R(q),   D = 1 + dt (the destruction rate),
+R the whole explicit right-hand side (advection, diffusion, sources less sinks), L_j with the flat cells'
+advection across the rings (first-order upwind there, as the flow's): the approximate factorisation makes the
+thin wall cells' diffusion and advection and the stiff destruction implicit, and a settled state satisfies
+R = 0 exactly, whatever the step.  First order in time (the flow's velocity is second order; the model lags it
+by a step anyway).
+
+The outer boundary's k and omega (two ghost rings): the freestream's, or the background's on the overset pair
+(bridge.cfd.body_fitted.BodyFittedSST).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from kernels import transport as _t
+
+from .ogrid import _distance_to_polyline
+from .turbulence import BETA_1
+
+__all__ = ["CurvilinearSST", "first_height_for"]
+
+_C = {name: float(getattr(_t, f"SST_{name}").value) for name in
+      ("BETA_STAR", "A1", "SIGMA_K1", "SIGMA_K2", "SIGMA_W1", "SIGMA_W2", "BETA1", "BETA2", "GAMMA1", "GAMMA2")}
+
+
+def first_height_for(reynolds: float, y_plus: float = 1.0, chord: float = 1.0) -> float:
+    """The first cell height that puts y+ near ``y_plus`` on a turbulent flat plate of length ``chord`` at
+    ``reynolds`` (on the chord): c_f = 0.026 Re^(-1/7) (White 2006, eq. 6-121), u_tau = U sqrt(c_f / 2)."""
+    if not (reynolds > 0 and y_plus > 0 and chord > 0):
+        raise ValueError(f"first_height_for: reynolds, y_plus, chord must be > 0, got {reynolds}, {y_plus}, {chord}")
+    cf = 0.026 * reynolds ** (-1.0 / 7.0)
+    return y_plus * chord / (reynolds * math.sqrt(cf / 2.0))
+
+
+def sst_terms(k, w, s2, grad_kw, d, nu):
+    """The SST-2003 coefficients of cells (turbulence.py's equations; the same as
+    ``kernels.transport.sst_coefficients``): nu_t, the blending F1, k's source and sink rate, omega's source and
+    sink rate (destruction and the negative part of the cross diffusion, implicit)."""
+    c = _C
+    kk = np.maximum(k, 0.0)
+    ww = np.maximum(w, 1e-30)
+    cd = np.maximum(2.0 * c["SIGMA_W2"] * grad_kw / ww, 1e-10)
+    sk = np.sqrt(kk)
+    arg1 = np.minimum(np.maximum(sk / (c["BETA_STAR"] * ww * d), 500.0 * nu / (d * d * ww)),
+                      4.0 * c["SIGMA_W2"] * kk / (cd * d * d))
+    f1 = np.tanh(arg1 ** 4)
+    arg2 = np.maximum(2.0 * sk / (c["BETA_STAR"] * ww * d), 500.0 * nu / (d * d * ww))
+    f2 = np.tanh(arg2 ** 2)
+    nu_t = c["A1"] * kk / np.maximum(c["A1"] * ww, np.sqrt(s2) * f2)
+    beta = f1 * c["BETA1"] + (1 - f1) * c["BETA2"]
+    gamma = f1 * c["GAMMA1"] + (1 - f1) * c["GAMMA2"]
+    cross = 2.0 * (1 - f1) * c["SIGMA_W2"] * grad_kw / ww
+    src_k = np.minimum(nu_t * s2, 10.0 * c["BETA_STAR"] * kk * ww)
+    snk_k = c["BETA_STAR"] * ww
+    src_w = gamma * s2 + np.maximum(cross, 0.0)
+    snk_w = beta * ww + np.maximum(-cross, 0.0) / ww
+    return nu_t, f1, (src_k, snk_k), (src_w, snk_w)
+
+
+class CurvilinearSST:
+    """SST-2003 on a :class:`~bridge.cfd.curvilinear.CurvilinearFlow` (module doc), a turbulence model of
+    bridge/cfd/flow.py: ``flow.step`` advances it after the velocity and it hands the flow nu_t.
+
+    ``k_inf``, ``omega_inf``: the initial state and the freestream's; ``ghosts``: the two ghost rings' k and omega
+    at a time, ``ghosts(t) -> ((2, ni), (2, ni))`` (default: the freestream's); ``attach=False`` leaves the
+    stepping to a coupled model (the overset pair's)."""
+
+    name = "sst"
+
+    def __init__(self, flow, k_inf: float, omega_inf: float, ghosts=None, attach: bool = True):
+        if not (k_inf >= 0 and omega_inf > 0):
+            raise ValueError(f"k_inf >= 0 and omega_inf > 0 needed, got {k_inf}, {omega_inf}")
+        import warp as wp
+
+        self.flow = flow
+        g = flow.grid
+        self.nu = flow.nu
+        self.k_inf, self.omega_inf = float(k_inf), float(omega_inf)
+        self._ghosts = ghosts
+        wall = np.column_stack([g.x[0], g.y[0]])
+        self.wall_distance = _distance_to_polyline(np.column_stack([g.xc.ravel(), g.yc.ravel()]),
+                                                   wall).reshape(g.xc.shape)
+        self.omega_wall = 60.0 * self.nu / (BETA_1 * self.wall_distance[0] ** 2)   # (ni,), on the wall faces
+        self.k = np.full((g.nj, g.ni), self.k_inf)
+        self.omega = np.full((g.nj, g.ni), self.omega_inf)
+        self._ones = wp.array(np.ones(g.ni), dtype=wp.float64, device="cpu")     # the half-cell wall gradient
+        self._zeros = wp.array(np.zeros(g.ni), dtype=wp.float64, device="cpu")
+        self.update(flow.t)
+        if attach:
+            flow.use_turbulence(self)
+
+    # --- boundary values ------------------------------------------------------------------------------
+    def ghosts(self, t: float) -> tuple[np.ndarray, np.ndarray]:
+        """(2, ni) k and omega of the two ghost rings beyond the outer boundary."""
+        if self._ghosts is None:   # a uniform stream: the freestream's
+            shape = self.flow.grid.xg.shape
+            return np.full(shape, self.k_inf), np.full(shape, self.omega_inf)
+        return self._ghosts(t)
+
+    def _walls(self):
+        """((k on the wall faces, at the wall nodes), (omega ...)): node i lies between faces i-1 and i."""
+        ni, ow = self.flow.grid.ni, self.omega_wall
+        return (np.zeros(ni), np.zeros(ni)), (ow, 0.5 * (ow + np.roll(ow, 1)))
+
+    # --- coefficients ---------------------------------------------------------------------------------
+    def update(self, t: float) -> None:
+        """The model's coefficients and the flow's nu_t from the flow's velocity and k, omega now."""
+        flow = self.flow
+        (wfu, wfv), _, (gu, gv) = flow._boundary(t)
+        (ux, uy), (vx, vy) = (flow.cell_gradient(q, wf, 0.5 * (q[-1] + gh[0]))
+                              for q, wf, gh in ((flow.u, wfu, gu), (flow.v, wfv, gv)))
+        s2 = 2.0 * (ux * ux + vy * vy) + (uy + vx) ** 2
+        kg, wg = self.ghosts(t)
+        (kw, _), (ww, _) = self._walls()
+        kx, ky = flow.cell_gradient(self.k, kw, 0.5 * (self.k[-1] + kg[0]))
+        wx, wy = flow.cell_gradient(self.omega, ww, 0.5 * (self.omega[-1] + wg[0]))
+        nu_t, self.f1, self.k_terms, self.w_terms = sst_terms(self.k, self.omega, s2, kx * wx + ky * wy,
+                                                              self.wall_distance, self.nu)
+        self.nu_t = nu_t
+        flow.set_eddy_viscosity(nu_t)
+
+    def _face_diffusivity(self, sigma_1: float, sigma_2: float):
+        """nu + sigma nu_t on the i- and j-faces (cell values averaged; the wall face nu, the outer the ring's)."""
+        cell = self.f1 * sigma_1 + (1 - self.f1) * sigma_2
+        st = cell * self.nu_t
+        gi = self.nu + 0.5 * (st + np.roll(st, 1, axis=1))
+        gj = self.nu + np.vstack([np.zeros((1, st.shape[1])), 0.5 * (st[1:] + st[:-1]), st[-1:]])
+        return gi, gj
+
+    # --- the step -------------------------------------------------------------------------------------
+    def residual(self, q, terms, sigmas, wall, ghosts, Fi_rel, Fj_rel):
+        """R(q): -advection + diffusion + source - sink q per cell area (module doc), and the faces'
+        diffusivities."""
+        flow = self.flow
+        gi, gj = self._face_diffusivity(*sigmas)
+        wall_face, wall_node = wall
+        adv = flow._advection(q, flow._ring_values(q, wall_face, ghosts), Fi_rel, Fj_rel, implicit="upwind")
+        one, zero = np.ones(flow.grid.ni), np.zeros(flow.grid.ni)
+        cross, around, rings = flow.diffusion_parts(q, gi, gj, wall_face, wall_node, ghosts, one, zero)
+        src, snk = terms
+        return cross + around + rings - adv + src - snk * q, gi, gj
+
+    def advance(self, dt: float) -> None:
+        """The model over the step its flow has just taken (the flow calls it): :meth:`transport`."""
+        self.transport(dt)
+
+    def transport(self, dt: float) -> None:
+        """k and omega over the step the flow has just taken (module doc), then nu_t for its next."""
+        flow = self.flow
+        g, t = flow.grid, flow.t
+        self.update(t)
+        Fi_rel = flow.Fi - flow._grid_flux(t, g.xmi, g.Si)
+        Fj_rel = flow.Fj - flow._grid_flux(t, g.xmj, g.Sj)
+        Fj_rel[0] = 0.0
+        kg, wg = self.ghosts(t)
+        kw, ww = self._walls()
+        c = _C
+        new = []
+        for q, terms, sigmas, wall, gh in ((self.k, self.k_terms, (c["SIGMA_K1"], c["SIGMA_K2"]), kw, kg),
+                                           (self.omega, self.w_terms, (c["SIGMA_W1"], c["SIGMA_W2"]), ww, wg)):
+            R, gi, gj = self.residual(q, terms, sigmas, wall, gh, Fi_rel, Fj_rel)
+            D = 1.0 + dt * terms[1]
+            k_m, k_p, k_lo, k_hi, diag = flow.implicit_coefficients(dt, gi, gj, Fj_rel)
+            dq = flow.line_solve(dt * R / D, k_m / D, k_p / D, k_lo / D, k_hi / D, diag / D, self._ones, self._zeros)
+            new.append(q + dq)
+        self.k = np.maximum(new[0], 0.0)
+        self.omega = np.maximum(new[1], 1e-6 * self.omega_inf)
+        self.update(t)
+
+    def stable_dt(self) -> float:
+        """None of its own beyond the flow's: advection has the flow's Courant number, the rest is implicit but
+        the cross-derivative diffusion of skewed cells, limited as the flow's with the k and omega
+        diffusivities (at most the momentum's nu + nu_t)."""
+        return math.inf
+
+    def state_arrays(self) -> dict[str, np.ndarray]:
+        return {"k": self.k, "omega": self.omega}
+
+    def restore(self, arrays: dict[str, np.ndarray]) -> None:
+        for name in ("k", "omega"):
+            value = np.asarray(arrays[name], dtype=np.float64)
+            if value.shape != getattr(self, name).shape:
+                raise ValueError(f"field {name!r}: saved shape {value.shape}, this grid's {getattr(self, name).shape}")
+            setattr(self, name, value.copy())
+        self.update(self.flow.t)
