@@ -22,7 +22,7 @@ def line_solve_rings(k_lo: wp.array2d(dtype=wp.float64), k_hi: wp.array2d(dtype=
                      cp: wp.array2d(dtype=wp.float64), x: wp.array2d(dtype=wp.float64)):
     i = wp.tid()
     one = wp.float64(1.0)
-    # ring 0: diagonal 1 + k_hi + k_lo w0, upper -(k_hi - k_lo w1)
+    # ring 0: diagonal 1 + k_hi + k_lo w0 + diag, upper -(k_hi - k_lo w1)
     d = one + k_hi[0, i] + k_lo[0, i] * w0[i] + diag[0, i]
     up = -(k_hi[0, i] - k_lo[0, i] * w1[i])
     cp[0, i] = up / d

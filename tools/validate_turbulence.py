@@ -32,7 +32,7 @@ on the upper side comes from the wall law through the velocity of the first u-fa
 dy above the wall (as the wall function sees it); reported: c_f at x = 0.97 against TMR's resolved
 0.00271-0.00272, its y+, and the drag force beside the friction integrated from c_f(x) on both sides.
 ogplate: the same plate on the body-fitted wall (bridge/cfd/curvilinear_sst.py: SST resolved to the wall on an
-O-grid): a plate 2 long and ``--thickness`` thick (0.02: 1 % of its length) with semi-elliptic ends (axes 20
+O-grid): a plate 2 long and ``--thickness`` thick (0.02: 1 % of its length) with semi-elliptic ends (axes 4
 thicknesses by one), the leading edge at x = 0, in a uniform stream (the O-grid's outer boundary ``--outer`` from
 the wall, default 1 as TMR's top boundary; the freestream's k and omega there, which decay on their way to the
 plate), ``--around`` wall nodes, the first cell ``--dy1`` high growing by ``--growth``. Reported as plate's: c_f
@@ -336,7 +336,7 @@ def ogplate_report(around, dy1, growth, thickness, outer, t_end, cfl):
     cf97 = float(np.interp(0.97008, x, cf))
     u_tau = np.sqrt(0.5 * cf97)
     i = int(np.argmin(np.abs(g.xmj[0, :, 0] - 0.97008) + 10 * (g.xmj[0, :, 1] < 0)))
-    yp = model.wall_distance[:, i] * u_tau * 5e6
+    yp = model.wall_distance[:, i] * u_tau / flow.nu
     up = flow.u[:, i] / u_tau
     band = (yp >= 30) & (yp <= 300)
     log = np.log(yp) / KAPPA + B

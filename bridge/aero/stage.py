@@ -86,7 +86,7 @@ def scenario_preset(scenario: Any, quality: str | None = None):
         air = scenario.air
         nu_air = air.kinematic_viscosity_m2_s if air is not None else 1.48e-5
         q = q.with_(turbulence=aopts.turbulence, reynolds=aopts.wind_speed_m_s * section.chord_m / nu_air,
-                    sst_walls=aopts.sst_walls)
+                    sst_walls="resolved" if aopts.grid == "body_fitted" else aopts.sst_walls)   # (its wall: resolved)
     return section, q
 
 

@@ -411,6 +411,7 @@ class BodyFittedPair(RigidPair, FlowBase):
         self.background.t, self.background.n_steps = float(t), int(n_steps)
         self.body.restore_arrays({k[5:]: v for k, v in arrays.items() if k.startswith("body/")}, t, n_steps)
         self.t, self.n_steps = float(t), int(n_steps)
+        self.body.outer._cache = {}   # (the model's nu_t below reads the boundary values at t)
         if self.turbulence is not LAMINAR:
             self.turbulence.body.restore({k[11:]: v for k, v in arrays.items() if k.startswith("turbulence/")})
         times = np.atleast_1d(arrays["psi_times"])
@@ -425,7 +426,8 @@ class BodyFittedSST:
     ``CurvilinearSST`` (its wall resolved), coupled as the velocity is (a turbulence model of bridge/cfd/flow.py,
     advanced by the pair after both velocity steps):
     * background: the cells whose centres lie inside the hole's ring are held at the O-grid's k and omega
-      (bilinear between its cell centres; those inside the body at the freestream's, which nothing reads);
+      (bilinear between its cell centres; those inside the body, and any the donor search cannot place, at the
+      freestream's: deep in the hole, which nothing reads);
       its wall distance counts the body's wall at its starting pose (off by the motion's amplitude, far from
       the wall: it only enters the blending functions there);
     * O-grid: its two ghost rings take the background's k and omega of the step's end (bilinear), at the

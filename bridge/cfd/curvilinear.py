@@ -12,7 +12,11 @@ every metric below is computed once.
 
 Equations (Beddhu, Taylor and Whitfield 1996: the absolute velocity in the body's axes, as the Cartesian
 overset pair's body grid, bridge/cfd/overset.py), with u_g = R^T V_O + Omega x xi the grid's velocity:
-  du/dt + div(u (u - u_g)) + Omega x u = -grad p + nu lap u,   div u = 0,   u = u_g on the wall.
+  du/dt + div(u (u - u_g)) + Omega x u = -grad p + div((nu + nu_t)(grad u + grad u^T)),   div u = 0,
+  u = u_g on the wall,
+nu_t a turbulence model's eddy viscosity (bridge/cfd/curvilinear_sst.py; zero when laminar, where the stress is
+nu lap u): nu + nu_t on the faces, the mean of the two cells' (the wall face nu, the outer face's extrapolated
+from the last two rings), its transpose part nu_t grad u^T explicit.
 
 Finite volumes (Zang, Street and Koseff 1994, J. Comput. Phys. 114: Cartesian velocity at the cell centres,
 volume fluxes F = u . S on the faces): the divergence of a cell is the sum of its faces' fluxes; a face's
@@ -26,12 +30,15 @@ steps (SBDF2; Ascher, Ruuth and Wetton 1995) - advection (van Leer's limited upw
 the frame's term and the diffusion's cross-derivative terms explicit, the rest of the diffusion implicit: around
 each ring and across the rings, approximately factorised into one line solve per grid line each way
 (kernels/curvilinear.py), so that neither the thin wall cells nor the fine spacing along the wall limit the
-step; BDF2 damps the stiff modes that Crank-Nicolson would leave ringing.  Then the projection, incremental (van
+step; BDF2 damps the stiff modes that Crank-Nicolson would leave ringing.  Between cells flatter than
+IMPLICIT_ASPECT (along the wall over across it; ``grid.implicit_j``) the advection across the rings is implicit
+too, first-order upwind, in the same line solves: at Re 1e8 the flow crossing the wall cells at a sharp corner
+would otherwise set a step a hundred times shorter.  Then the projection, incremental (van
 Kan 1986): the predicted face fluxes (Rhie and Chow's interpolation: the cell pressure gradient taken out, the
 face's put back), D G phi = D F* / c with the nine-point face gradient (a constant matrix, factorised once),
 F = F* - c G phi on the faces, u = u* - c grad phi at the centres (Green-Gauss, the boundary faces' values
 extrapolated along the grid lines), p += phi, c = dt over BDF2's leading coefficient.  The step is set by the
-convective Courant number (and the explicit cross terms of skewed cells).
+convective Courant number of the explicit faces (and the explicit cross terms of skewed cells).
 
 The outer boundary's velocity (two rings of ghost cells) and face fluxes come from an ``outer`` provider:
 :class:`Farfield` (a uniform stream), or the Cartesian background of an overset pair.
@@ -383,15 +390,21 @@ class CurvilinearFlow(FlowBase):
         """The eddy viscosity of the cells (nj, ni), from a turbulence model: the momentum's diffusivity becomes
         nu + nu_t on the faces (the mean of the two cells; the wall face nu alone, the outer face's extrapolated
         from the last two rings), and its stress nu_t (grad u + grad u^T) (the transpose part explicit)."""
-        g = self.grid
         nu_t = np.asarray(nu_t, dtype=np.float64)
         self.nu_t = nu_t
+        face_i, face_j = self.eddy_faces(nu_t)
+        self.nu_i, self.nu_j = self.nu + face_i, self.nu + face_j
+        self._turbulent = bool(np.any(nu_t != 0.0))
+
+    def eddy_faces(self, cell: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """A cell field of eddy diffusivity on the i-faces (nj, ni) and j-faces (nj + 1, ni): the mean of the two
+        cells, zero on the wall face, extrapolated along the grid lines on the outer face (not below zero)."""
+        g = self.grid
         e1 = np.hypot(g.xmj[-1, :, 0] - g.xc[-1], g.xmj[-1, :, 1] - g.yc[-1])
         e2 = np.hypot(g.xc[-1] - g.xc[-2], g.yc[-1] - g.yc[-2])
-        outer = np.maximum(nu_t[-1] + (nu_t[-1] - nu_t[-2]) * e1 / e2, 0.0)   # extrapolated along the grid lines
-        self.nu_i = self.nu + 0.5 * (nu_t + np.roll(nu_t, 1, axis=1))
-        self.nu_j = self.nu + np.vstack([np.zeros((1, g.ni)), 0.5 * (nu_t[1:] + nu_t[:-1]), outer[None]])
-        self._turbulent = bool(np.any(nu_t != 0.0))
+        outer = np.maximum(cell[-1] + (cell[-1] - cell[-2]) * e1 / e2, 0.0)
+        return (0.5 * (cell + np.roll(cell, 1, axis=1)),
+                np.vstack([np.zeros((1, g.ni)), 0.5 * (cell[1:] + cell[:-1]), outer[None]]))
 
     def cell_gradient(self, q, q_wall_face, q_outer_face) -> tuple[np.ndarray, np.ndarray]:
         """grad q at the cell centres by Green-Gauss: interior faces the mean of their two cells, the wall and

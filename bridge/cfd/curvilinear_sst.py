@@ -7,12 +7,15 @@ same operators as the velocity: van Leer's limited upwinding relative to the gri
 metric, the faces' diffusivity the mean of their two cells'.
 
 Wall (Menter 1994, AIAA J. 32: 1598; as NASA TMR's "SST" page recommends): k = 0 and
-omega = 60 nu / (beta_1 d_1^2) on the wall face, d_1 the first cell centre's distance from the wall; the
+omega = 60 nu / (beta_1 d_1^2) on the wall face, d_1 the first cell centre's distance from the wall (the
+Cartesian model takes the first cell's height, a quarter of the value: both are Menter's, and the result does
+not depend on the factor while the first cell lies in the viscous sublayer); the
 wall face's gradient the half-cell difference (omega ~ 1/d^2 next to a wall: a quadratic through the first
 two rings would be worse than none).  Wall functions are not offered: the O-grid is graded from the wall, so
 y+ ~ 1 costs tens of rings even at Re 1e8 (``first_height_for``).
 
-Time step: one step per flow step, after it (segregated, as the Cartesian model), in delta form,
+Time step: one step per flow step, after it (segregated: the coefficients and nu_t from the flow's new
+velocity; nu_t handed on is the new k and omega's), in delta form,
   (D - dt L_i) D^-1 (D - dt L_j) dq = dt R(q),   D = 1 + dt (the destruction rate),
 R the whole explicit right-hand side (advection, diffusion, sources less sinks), L_j with the flat cells'
 advection across the rings (first-order upwind there, as the flow's): the approximate factorisation makes the
@@ -96,8 +99,10 @@ class CurvilinearSST:
         self.k_inf, self.omega_inf = float(k_inf), float(omega_inf)
         self._ghosts = ghosts
         wall = np.column_stack([g.x[0], g.y[0]])
-        self.wall_distance = _distance_to_polyline(np.column_stack([g.xc.ravel(), g.yc.ravel()]),
-                                                   wall).reshape(g.xc.shape)
+        centres = np.column_stack([g.xc.ravel(), g.yc.ravel()])
+        chunk = max(1, 2_000_000 // g.ni)   # points x wall segments at a time: the temporaries stay small
+        self.wall_distance = np.concatenate([_distance_to_polyline(centres[k:k + chunk], wall)
+                                             for k in range(0, len(centres), chunk)]).reshape(g.xc.shape)
         self.omega_wall = 60.0 * self.nu / (BETA_1 * self.wall_distance[0] ** 2)   # (ni,), on the wall faces
         self.k = np.full((g.nj, g.ni), self.k_inf)
         self.omega = np.full((g.nj, g.ni), self.omega_inf)
@@ -138,12 +143,12 @@ class CurvilinearSST:
         flow.set_eddy_viscosity(nu_t)
 
     def _face_diffusivity(self, sigma_1: float, sigma_2: float):
-        """nu + sigma nu_t on the i- and j-faces (cell values averaged; the wall face nu, the outer the ring's)."""
-        cell = self.f1 * sigma_1 + (1 - self.f1) * sigma_2
-        st = cell * self.nu_t
-        gi = self.nu + 0.5 * (st + np.roll(st, 1, axis=1))
-        gj = self.nu + np.vstack([np.zeros((1, st.shape[1])), 0.5 * (st[1:] + st[:-1]), st[-1:]])
-        return gi, gj
+        """nu + sigma nu_t on the i- and j-faces: the flow's rule for nu_t (``eddy_faces``) but on the outer
+        face, which takes the outer ring's value."""
+        sigma = self.f1 * sigma_1 + (1 - self.f1) * sigma_2
+        gi, gj = self.flow.eddy_faces(sigma * self.nu_t)
+        gj[-1] = (sigma * self.nu_t)[-1]   # the outer face: the outer ring's (no extrapolation)
+        return self.nu + gi, self.nu + gj
 
     # --- the step -------------------------------------------------------------------------------------
     def residual(self, q, terms, sigmas, wall, ghosts, Fi_rel, Fj_rel):
@@ -187,8 +192,10 @@ class CurvilinearSST:
 
     def stable_dt(self) -> float:
         """None of its own beyond the flow's: advection has the flow's Courant number, the rest is implicit but
-        the cross-derivative diffusion of skewed cells, limited as the flow's with the k and omega
-        diffusivities (at most the momentum's nu + nu_t)."""
+        the cross-derivative diffusion of skewed cells, whose k and omega diffusivities nu + sigma nu_t (sigma
+        <= 1) are about the momentum's nu + nu_t at most, by which the flow limits its step (on the outer face
+        the ring's value against the flow's extrapolated one; and nu_t of the step's start: the limit lags the
+        model by a step, as any segregated scheme's)."""
         return math.inf
 
     def state_arrays(self) -> dict[str, np.ndarray]:

@@ -5,12 +5,15 @@ by name.  DFG 2D-1 against its published bands: tools/validate_body_fitted.py (d
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 
 from bridge.aero.forced_motion import ForcedCase
 from bridge.aero.options import AeroOptions
 from bridge.aero.presets import build_flow, preset, section_polygons
+from bridge.aero.stage import scenario_preset
 from bridge.cfd import BoundaryConditions, CartesianGrid, Flow, FlowConfig, PrescribedMotion, Stationary, run
 from bridge.cfd.body_fitted import BodyFittedPair, BodyFittedSST, node_stream_function
 from bridge.cfd.curvilinear import CurvilinearFlow, CurvilinearGrid, Farfield, polar_grid
@@ -90,6 +93,11 @@ def test_a_body_fitted_case_resumes_bit_for_bit(turbulence):
     run(b, 2.0, max_steps=15)
     assert a.n_steps == b.n_steps and np.array_equal(a.total_force, b.total_force)
     assert np.array_equal(a.body.u, b.body.u) and np.array_equal(a.background.u.numpy(), b.background.u.numpy())
+    if turbulence == "sst":   # k and omega on both grids
+        ta, tb = a.turbulence, b.turbulence
+        assert np.array_equal(ta.body.k, tb.body.k) and np.array_equal(ta.body.omega, tb.body.omega)
+        assert np.array_equal(ta.background.k.q.numpy(), tb.background.k.q.numpy())
+        assert np.array_equal(ta.background.omega.q.numpy(), tb.background.omega.q.numpy())
 
 
 def test_what_the_body_fitted_grid_cannot_do_yet_is_refused_by_name():
@@ -104,6 +112,8 @@ def test_sst_on_the_body_fitted_pair_resolves_the_wall():
     """With SST the preset's O-grid starts at y+ ~ 1 (White's turbulent plate at the case's Reynolds number) and
     both grids carry the model; the sst_walls option does not apply (the wall is resolved)."""
     assert AeroOptions(grid="body_fitted").turbulence == "sst"
+    scenario = SimpleNamespace(deck_section=None, aero=AeroOptions(grid="body_fitted"), air=None)
+    assert scenario_preset(scenario)[1].physics.sst_walls == "resolved"   # what the report and summary then say
     q = preset("tiny", "body_fitted").with_(turbulence="sst", reynolds=1e6)
     flow = build_flow(q, section_polygons(FlatPlate(1.0, 0.04))[:1], ForcedCase.thesis("heave", 1.0))
     assert isinstance(flow.turbulence, BodyFittedSST) and flow.turbulence.name == "sst"
