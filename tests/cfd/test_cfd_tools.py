@@ -88,6 +88,7 @@ def test_the_period_peaks_of_a_growing_sine_are_its_envelope():
     assert np.allclose(values, 0.2 + 1.0 + 0.1 * (starts + 0.25), atol=0.01)   # each at its quarter period
 
 
+@pytest.mark.slow   # 5 s: out of the default run, which must stay under 2 minutes
 def test_dfg2_starts_from_a_saved_background_and_reaches_the_same_forces(tmp_path, capsys):
     """--save-state / --start-from: a run restarted from its own background at t = 0.1 (the body grid set from
     it) gives the drag of the run that went through, once its settling (0.05) is left out of the window; a
