@@ -69,7 +69,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from openfoam_plate import HEADER, graded, grading_spec, run  # noqa: E402
+from openfoam_plate import HEADER, control_dict, graded, grading_spec, run  # noqa: E402
 
 from bridge.errors import InputError, check_range  # noqa: E402
 
@@ -198,27 +198,7 @@ def write_case(case: Path, name: str, around: int, t_end: float, max_co: float, 
     umax = UMAX[name]
     ubar = 2 * umax / 3
     write_interval = t_end / max(1, round(t_end))     # about 1, and t_end a whole number of them: written at the end
-    (case / "system" / "controlDict").write_text(HEADER.format(cls="dictionary", obj="controlDict") + f"""
-application pimpleFoam;
-startFrom latestTime;
-startTime 0;
-stopAt endTime;
-endTime {t_end:.12g};
-deltaT 1e-5;
-writeControl adjustableRunTime;
-writeInterval {write_interval:.12g};
-purgeWrite 2;
-writeFormat binary;
-writePrecision 12;
-timeFormat general;
-timePrecision 12;
-runTimeModifiable no;
-adjustTimeStep yes;
-maxCo {max_co:g};
-maxDeltaT 0.01;
-functions
-{{
-    forceCoeffs
+    functions = f"""    forceCoeffs
     {{
         type forceCoeffs;
         libs ("libforces.so");
@@ -236,8 +216,8 @@ functions
         writeInterval 1;
         log false;
     }}
-}}
-""")
+"""
+    (case / "system" / "controlDict").write_text(control_dict(t_end, "1e-5", write_interval, max_co, "0.01", functions))
     (case / "system" / "fvSchemes").write_text(HEADER.format(cls="dictionary", obj="fvSchemes") + f"""
 ddtSchemes {{ default backward; }}
 gradSchemes {{ default Gauss linear; }}

@@ -165,6 +165,34 @@ def block_mesh_dict(edge: float, thickness: float, growth: float) -> tuple[str, 
 # ---------------------------------------------------------------------------------------------- the case
 
 
+def control_dict(end_time: float, delta_t: str, write_interval: float, max_co: float, max_delta_t: str,
+                 functions: str) -> str:
+    """system/controlDict of a pimpleFoam case: adjustable steps at ``max_co``, written every ``write_interval``
+    (the last two kept, binary), restarted from the latest time; ``functions`` the function objects' entries."""
+    return HEADER.format(cls="dictionary", obj="controlDict") + f"""
+application pimpleFoam;
+startFrom latestTime;
+startTime 0;
+stopAt endTime;
+endTime {end_time:.12g};
+deltaT {delta_t};
+writeControl adjustableRunTime;
+writeInterval {write_interval:.12g};
+purgeWrite 2;
+writeFormat binary;
+writePrecision 12;
+timeFormat general;
+timePrecision 12;
+runTimeModifiable no;
+adjustTimeStep yes;
+maxCo {max_co:g};
+maxDeltaT {max_delta_t};
+functions
+{{
+{functions}}}
+"""
+
+
 def write_case(case: Path, dof: str, K: float, amplitude: float, reynolds: float, thickness: float,
                edge: float, growth: float, end_time: float, write_interval: float, procs: int, max_co: float,
                turbulence: str = "laminar", angle: float = 0.0) -> int:
@@ -184,27 +212,7 @@ def write_case(case: Path, dof: str, K: float, amplitude: float, reynolds: float
         writeControl writeTime;
         fields (p {{ mean on; prime2Mean off; base time; }});
     }}"""
-    (case / "system" / "controlDict").write_text(HEADER.format(cls="dictionary", obj="controlDict") + f"""
-application pimpleFoam;
-startFrom latestTime;
-startTime 0;
-stopAt endTime;
-endTime {end_time:.12g};
-deltaT {0.2 * edge:.6g};
-writeControl adjustableRunTime;
-writeInterval {write_interval:.12g};
-purgeWrite 2;
-writeFormat binary;
-writePrecision 12;
-timeFormat general;
-timePrecision 12;
-runTimeModifiable no;
-adjustTimeStep yes;
-maxCo {max_co:g};
-maxDeltaT 1;
-functions
-{{
-    forces
+    functions = f"""    forces
     {{
         type forces;
         libs ("libforces.so");
@@ -216,8 +224,9 @@ functions
         writeInterval 1;
         log false;
     }}{average}
-}}
-""")
+"""
+    text = control_dict(end_time, f"{0.2 * edge:.6g}", write_interval, max_co, "1", functions)
+    (case / "system" / "controlDict").write_text(text)
     (case / "system" / "fvSchemes").write_text(HEADER.format(cls="dictionary", obj="fvSchemes") + """
 ddtSchemes { default backward; }
 gradSchemes { default Gauss linear; }
