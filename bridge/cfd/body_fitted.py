@@ -15,6 +15,11 @@ is conserved across the interface to round-off in both directions:
   stream function of its rigid motion, matched to the O-grid's on the wall.  The background's projection is
   incremental, so that the forced faces lose only the step's pressure increment (nothing once the flow
   settles): a steady flow does not depend on the time step.
+The O-grid sub-cycles: the pair's step is the background's stable step, and the O-grid takes as many equal
+steps of its own as its stable step needs to reach the same time, its outer values linear in time between the
+background's at the pair step's start and end (the O-grid's wall cells at corners, much smaller than the
+background's, set its step: on the Great Belt deck 20 times smaller).  ``subcycle=False`` steps both grids
+together at the smaller of the two steps.
 The force is the O-grid's wall integral of pressure and shear.
 """
 
@@ -194,11 +199,28 @@ class _BackgroundOuter:
     def attach(self, flow: CurvilinearFlow) -> None:
         self.flow = flow
 
+    def _cached(self, t: float):
+        tol = 1e-9 * max(1.0, abs(t))
+        for tk, values in self._cache.items():
+            if abs(tk - t) <= tol:
+                return values
+        return None
+
     def _values(self, t: float):
-        if t in self._cache:
-            return self._cache[t]
+        hit = self._cached(t)
+        if hit is not None:
+            return hit
         pair, g = self.pair, self.flow.grid
         bg = pair.background
+        t_bg = bg.t
+        earlier = [tk for tk in self._cache if tk < t]
+        if earlier and t < t_bg - 1e-9 * max(1.0, abs(t_bg)):
+            # an O-grid sub-step inside the pair's step: linear in time between its start and the background's
+            t0 = max(earlier)
+            (u0, v0), f0 = self._cache[t0]
+            (u1, v1), f1 = self._values(t_bg)
+            w = (t - t0) / (t_bg - t0)
+            return ((1 - w) * u0 + w * u1, (1 - w) * v0 + w * v1), (1 - w) * f0 + w * f1
         X, Y = pair.to_background(g.xg, g.yg, t)
         u, v = background_velocity(bg, X.ravel(), Y.ravel())
         th = pair.motion.pose(t)[2]
@@ -267,10 +289,11 @@ class BodyFittedPair(RigidPair, FlowBase):
     ``ogrid``: a :class:`CurvilinearGrid` in the body's coordinates (the reference point at 0); ``background``:
     a ``CartesianGrid``; ``config``: the background's ``FlowConfig`` (its nu and cfl serve the O-grid too);
     ``motion``: the body's rigid motion; ``overlap``: the hole starts this many background cells inside the
-    O-grid's outer ring, and at least ``ring_overlap`` of the O-grid's rings (default half of them)."""
+    O-grid's outer ring, and at least ``ring_overlap`` of the O-grid's rings (default half of them);
+    ``subcycle``: the O-grid takes several steps of its own in each of the background's (module doc)."""
 
     def __init__(self, background_grid, ogrid: CurvilinearGrid, config: FlowConfig, motion, overlap: float = 4.0,
-                 ring_overlap: int | None = None, device: str | None = None):
+                 ring_overlap: int | None = None, device: str | None = None, subcycle: bool = True):
         if overlap < 2:
             raise ValueError(f"overlap: must be >= 2 background cells, got {overlap}")
         # the background's projection is incremental: it takes from the hole's forced faces only the step's
@@ -307,6 +330,8 @@ class BodyFittedPair(RigidPair, FlowBase):
         self._psi_hist: list[tuple[float, np.ndarray]] = []
         self._hy_f = background_grid.hy_faces()
         self.turbulence = LAMINAR
+        self.subcycle = bool(subcycle)
+        self.last_substeps = 1
         self.t, self.n_steps = 0.0, 0
 
     # --- set-up and frames --------------------------------------------------------------------------
@@ -379,7 +404,35 @@ class BodyFittedPair(RigidPair, FlowBase):
 
     # --- step ----------------------------------------------------------------------------------
     def _flow_dt(self) -> float:
+        if self.subcycle:
+            return self.background.stable_dt()
         return min(self.background.stable_dt(), self.body.stable_dt())
+
+    def substeps(self, dt: float) -> int:
+        """The O-grid's steps in a pair step of ``dt`` (1 without sub-cycling)."""
+        if not self.subcycle:
+            return 1
+        return max(1, math.ceil(dt / self.body.stable_dt() - 1e-9))
+
+    def _advance_flow(self, dt: float) -> None:
+        """The background by ``dt`` (its hole from the O-grid extrapolated to the new time), then the O-grid to
+        the same time in :meth:`substeps` equal steps, each followed by its turbulence's (module doc); ``step``
+        then advances the turbulence model's background part."""
+        n = self.substeps(dt)
+        t0 = self.t
+        self.background.step(dt)
+        t1 = self.background.t
+        for k in range(1, n + 1):
+            t_k = t1 if k == n else t0 + (t1 - t0) * k / n
+            dt_k = t_k - self.body.t
+            self.body.step(dt_k)
+            if self.turbulence is not LAMINAR:
+                self.turbulence.transport_body(dt_k)
+        self.body.t = t1
+        self.t = t1
+        self._psi_hist = [self._psi_hist[-1], (self.t, self._body_stream_function())]
+        self.n_steps += 1
+        self.last_substeps = n
 
     def _body_stream_function(self) -> np.ndarray:
         return node_stream_function(self.body)
@@ -430,8 +483,9 @@ class BodyFittedSST:
       freestream's: deep in the hole, which nothing reads);
       its wall distance counts the body's wall at its starting pose (off by the motion's amplitude, far from
       the wall: it only enters the blending functions there);
-    * O-grid: its two ghost rings take the background's k and omega of the step's end (bilinear), at the
-      places the ghost cells have then: the background's own solution, outside the hole.
+    * O-grid: transported after each of its (sub-)steps (:meth:`transport_body`, called by the pair); its two
+      ghost rings take the background's k and omega of the pair step's start (bilinear), at the places the
+      ghost cells have then: the background's own solution, outside the hole.
     k and omega are scalars, the same in either frame."""
 
     name = "sst"
@@ -473,8 +527,13 @@ class BodyFittedSST:
         solid = pair._body_path.contains_points(pts).reshape(xi.shape)[inside]
         return (JJ[inside] + g, II[inside] + g), xi[inside], eta[inside], solid
 
+    def transport_body(self, dt: float) -> None:
+        """The O-grid's k and omega over the (sub-)step its flow has just taken."""
+        self.body.transport(dt)
+
     def advance(self, dt: float) -> None:
-        """k and omega of both grids over the step both flows have just taken (the background first)."""
+        """The background's k and omega over the step both flows have just taken, its hole cells held at the
+        O-grid's (transported already, in the O-grid's sub-steps)."""
         bg, body, t = self.background, self.body, self.pair.t
         bg.update()
         (J, I), xi, eta, solid = self.hole_cells(t)
@@ -487,7 +546,6 @@ class BodyFittedSST:
             w[fluid] = self.pair.locator.cells(body.omega, jf[ok], if_[ok])
             bg.hold(J, I, k, w)
         advance_pair(bg.k, bg.omega, dt)
-        body.transport(dt)
 
     def stable_dt(self) -> float:
         return min(self.background.stable_dt(), self.body.stable_dt())
