@@ -238,7 +238,10 @@ class CurvilinearFlow(FlowBase):
 
         init_warp("cpu")
         z = lambda: wp.zeros((nj, ni), dtype=wp.float64, device="cpu")  # noqa: E731
-        self._line_buffers = {"cp_i": z(), "y": z(), "z": z(), "x_i": z(), "cp_j": z(), "x_j": z()}
+        # the line solves' work arrays and coefficients, allocated once (the coefficients are copied in through
+        # the arrays' NumPy views: a new Warp array per coefficient and call cost a tenth of a step)
+        self._line_buffers = {name: z() for name in ("cp_i", "y", "z", "x_i", "cp_j", "x_j",
+                                                     "k_m", "k_p", "rhs", "k_lo", "k_hi", "diag")}
         self._w0 = wp.array(grid.wall_w0, dtype=wp.float64, device="cpu")
         self._w1 = wp.array(grid.wall_w1, dtype=wp.float64, device="cpu")
 
@@ -474,12 +477,13 @@ class CurvilinearFlow(FlowBase):
         from kernels import curvilinear as _kc
 
         nj, ni = self.grid.nj, self.grid.ni
-        arr = lambda a: wp.array(np.ascontiguousarray(a), dtype=wp.float64, device="cpu")  # noqa: E731
         w = self._line_buffers
+        for name, value in (("k_m", k_m), ("k_p", k_p), ("rhs", rhs), ("k_lo", k_lo), ("k_hi", k_hi), ("diag", diag)):
+            w[name].numpy()[...] = value
         wp.launch(_kc.line_solve_around, dim=nj, device="cpu",
-                  inputs=[arr(k_m), arr(k_p), arr(rhs), ni, w["cp_i"], w["y"], w["z"], w["x_i"]])
+                  inputs=[w["k_m"], w["k_p"], w["rhs"], ni, w["cp_i"], w["y"], w["z"], w["x_i"]])
         wp.launch(_kc.line_solve_rings, dim=ni, device="cpu",
-                  inputs=[arr(k_lo), arr(k_hi), arr(diag), w0, w1, w["x_i"], nj, w["cp_j"], w["x_j"]])
+                  inputs=[w["k_lo"], w["k_hi"], w["diag"], w0, w1, w["x_i"], nj, w["cp_j"], w["x_j"]])
         return w["x_j"].numpy().copy()
 
     def implicit_coefficients(self, c, gam_i, gam_j, Fj_rel):
