@@ -5,8 +5,8 @@ The coupling follows the Cartesian pair's (bridge/cfd/overset.py), through the s
 is conserved across the interface to round-off in both directions:
 * the O-grid's outer boundary: its face fluxes from differences of the background's stream function at the
   outer ring's nodes (cubic, bridge.cfd.overset.CornerInterpolator; they telescope to zero around the ring),
-  the velocity of its two ghost rings from the background's faces (bilinear), both at the step's new time
-  (the background steps first);
+  the velocity of its two ghost rings from the background's faces (bilinear), both at the pair step's new
+  time (the background steps first), linear in time between the step's two ends for the O-grid's sub-steps;
 * the background's hole: the faces whose corners lie inside ring ``j_hole`` of the O-grid (the ring at least
   ``overlap`` background cells inside the outer one) take the O-grid's velocity, from differences of the
   O-grid's stream function (its node values, summed from the face fluxes) interpolated at their corners
@@ -189,8 +189,9 @@ def node_stream_function(flow: CurvilinearFlow) -> np.ndarray:
 
 
 class _BackgroundOuter:
-    """The O-grid's outer boundary from the background (module doc); values of the last two times kept, so
-    that the O-grid's step gets its start's values as it had them."""
+    """The O-grid's outer boundary from the background (module doc); the values at the last two times the
+    background had are kept, so that a pair step gets its start's values as they were; a time between those
+    and the background's present one (an O-grid sub-step) is interpolated linearly, not kept."""
 
     def __init__(self, pair: BodyFittedPair):
         self.pair = pair
@@ -199,22 +200,22 @@ class _BackgroundOuter:
     def attach(self, flow: CurvilinearFlow) -> None:
         self.flow = flow
 
-    def _cached(self, t: float):
-        tol = 1e-9 * max(1.0, abs(t))
-        for tk, values in self._cache.items():
-            if abs(tk - t) <= tol:
-                return values
-        return None
+    @staticmethod
+    def _same(a: float, b: float) -> bool:
+        """The same time but for round-off (an O-grid's sub-steps sum to the pair step's end within an ulp)."""
+        return abs(a - b) <= 1e-12 * max(1.0, abs(a))
 
     def _values(self, t: float):
-        hit = self._cached(t)
-        if hit is not None:
-            return hit
+        for tk, values in self._cache.items():
+            if self._same(tk, t):
+                return values
         pair, g = self.pair, self.flow.grid
         bg = pair.background
         t_bg = bg.t
+        if self._same(t, t_bg):
+            t = t_bg
         earlier = [tk for tk in self._cache if tk < t]
-        if earlier and t < t_bg - 1e-9 * max(1.0, abs(t_bg)):
+        if earlier and t < t_bg:
             # an O-grid sub-step inside the pair's step: linear in time between its start and the background's
             t0 = max(earlier)
             (u0, v0), f0 = self._cache[t0]
@@ -409,7 +410,8 @@ class BodyFittedPair(RigidPair, FlowBase):
         return min(self.background.stable_dt(), self.body.stable_dt())
 
     def substeps(self, dt: float) -> int:
-        """The O-grid's steps in a pair step of ``dt`` (1 without sub-cycling)."""
+        """The O-grid's steps in a pair step of ``dt`` (1 without sub-cycling), from its stable step at the pair
+        step's start.  (``body.n_steps`` counts them; a resumed run restarts that count at the pair's.)"""
         if not self.subcycle:
             return 1
         return max(1, math.ceil(dt / self.body.stable_dt() - 1e-9))
@@ -476,8 +478,9 @@ class BodyFittedPair(RigidPair, FlowBase):
 
 class BodyFittedSST:
     """SST-2003 on a :class:`BodyFittedPair`: the background's ``KOmegaSST`` and the O-grid's
-    ``CurvilinearSST`` (its wall resolved), coupled as the velocity is (a turbulence model of bridge/cfd/flow.py,
-    advanced by the pair after both velocity steps):
+    ``CurvilinearSST`` (its wall resolved), coupled as the velocity is (a turbulence model of bridge/cfd/flow.py:
+    its O-grid part transported by the pair after each O-grid sub-step, its background part advanced after
+    the pair step):
     * background: the cells whose centres lie inside the hole's ring are held at the O-grid's k and omega
       (bilinear between its cell centres; those inside the body, and any the donor search cannot place, at the
       freestream's: deep in the hole, which nothing reads);
@@ -485,7 +488,7 @@ class BodyFittedSST:
       the wall: it only enters the blending functions there);
     * O-grid: transported after each of its (sub-)steps (:meth:`transport_body`, called by the pair); its two
       ghost rings take the background's k and omega of the pair step's start (bilinear), at the places the
-      ghost cells have then: the background's own solution, outside the hole.
+      ghost cells have at the sub-step's end: the background's own solution, outside the hole.
     k and omega are scalars, the same in either frame."""
 
     name = "sst"

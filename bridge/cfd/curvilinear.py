@@ -479,6 +479,8 @@ class CurvilinearFlow(FlowBase):
         nj, ni = self.grid.nj, self.grid.ni
         w = self._line_buffers
         for name, value in (("k_m", k_m), ("k_p", k_p), ("rhs", rhs), ("k_lo", k_lo), ("k_hi", k_hi), ("diag", diag)):
+            if np.shape(value) != (nj, ni):
+                raise ValueError(f"line_solve: {name} has shape {np.shape(value)}, the grid's is {(nj, ni)}")
             w[name].numpy()[...] = value
         wp.launch(_kc.line_solve_around, dim=nj, device="cpu",
                   inputs=[w["k_m"], w["k_p"], w["rhs"], ni, w["cp_i"], w["y"], w["z"], w["x_i"]])
