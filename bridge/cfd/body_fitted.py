@@ -416,14 +416,11 @@ class BodyFittedPair(RigidPair, FlowBase):
             return 1
         return max(1, math.ceil(dt / self.body.stable_dt() - 1e-9))
 
-    def _advance_flow(self, dt: float) -> None:
-        """The background by ``dt`` (its hole from the O-grid extrapolated to the new time), then the O-grid to
-        the same time in :meth:`substeps` equal steps, each followed by its turbulence's (module doc); ``step``
-        then advances the turbulence model's background part."""
+    def _advance_body(self, dt: float) -> None:
+        """The O-grid to the background's new time in :meth:`substeps` equal steps, each followed by its
+        turbulence's (module doc); ``step`` then advances the turbulence model's background part."""
         n = self.substeps(dt)
-        t0 = self.t
-        self.background.step(dt)
-        t1 = self.background.t
+        t0, t1 = self.body.t, self.background.t
         for k in range(1, n + 1):
             t_k = t1 if k == n else t0 + (t1 - t0) * k / n
             dt_k = t_k - self.body.t
@@ -431,9 +428,6 @@ class BodyFittedPair(RigidPair, FlowBase):
             if self.turbulence is not LAMINAR:
                 self.turbulence.transport_body(dt_k)
         self.body.t = t1
-        self.t = t1
-        self._psi_hist = [self._psi_hist[-1], (self.t, self._body_stream_function())]
-        self.n_steps += 1
         self.last_substeps = n
 
     def _body_stream_function(self) -> np.ndarray:

@@ -286,10 +286,14 @@ class RigidPair:
         time), then the body grid (its boundary from the background at the new time); ``step`` then advances
         the turbulence model with the new velocities."""
         self.background.step(dt)
-        self.body.step(dt)
+        self._advance_body(dt)
         self.t = self.body.t
         self._psi_hist = [self._psi_hist[-1], (self.t, self._body_stream_function())]
         self.n_steps += 1
+
+    def _advance_body(self, dt: float) -> None:
+        """The body grid to the background's new time (one step of ``dt``; a pair may sub-cycle it)."""
+        self.body.step(dt)
 
     @property
     def total_force(self) -> np.ndarray:
