@@ -197,10 +197,6 @@ class Farfield:
         return ub * S[:, 0] + vb * S[:, 1]
 
 
-def _van_leer(r):
-    return (r + np.abs(r)) / (1.0 + np.abs(r))
-
-
 class CurvilinearFlow(FlowBase):
     """The incompressible flow on a body-fitted grid (module doc): a flow of bridge/cfd/flow.py.
 
@@ -244,6 +240,14 @@ class CurvilinearFlow(FlowBase):
                                                      "k_m", "k_p", "rhs", "k_lo", "k_hi", "diag")}
         self._w0 = wp.array(grid.wall_w0, dtype=wp.float64, device="cpu")
         self._w1 = wp.array(grid.wall_w1, dtype=wp.float64, device="cpu")
+        # the explicit stencils' constant geometry and their work arrays (with their NumPy views)
+        const = lambda a, dtype=wp.float64: wp.array(np.ascontiguousarray(a), dtype=dtype, device="cpu")  # noqa: E731
+        self._geo = {"area": const(grid.area), "alpha_i": const(grid.alpha_i), "beta_i": const(grid.beta_i),
+                     "alpha_j": const(grid.alpha_j), "beta_j": const(grid.beta_j),
+                     "six": const(grid.Si[..., 0]), "siy": const(grid.Si[..., 1]),
+                     "sjx": const(grid.Sj[..., 0]), "sjy": const(grid.Sj[..., 1]),
+                     "implicit_j": const(grid.implicit_j.astype(np.int32), wp.int32)}
+        self._work = {}
 
     # --- operators ------------------------------------------------------------------------------
     def _node_matrix(self) -> sp.csr_matrix:
@@ -359,37 +363,40 @@ class CurvilinearFlow(FlowBase):
         """q with the wall's reflection below ring 0 and the two ghost rings above: (nj + 3, ni), rows -1 .. nj+1."""
         return np.vstack([2 * q_wall_face[None] - q[:1], q, ghosts])
 
+    def _buffer(self, name: str, shape: tuple) -> tuple:
+        """A work array of the Warp kernels (allocated once per name and shape) and its NumPy view."""
+        import warp as wp
+
+        entry = self._work.get(name)
+        if entry is None or entry[1].shape != tuple(shape):
+            a = wp.zeros(tuple(shape), dtype=wp.float64, device="cpu")
+            entry = self._work[name] = (a, a.numpy())
+        return entry
+
+    def _warp(self, name: str, value) -> object:
+        """``value`` copied into the work array ``name`` (a Warp array is passed as it is)."""
+        if not isinstance(value, np.ndarray) and hasattr(value, "device"):
+            return value
+        a, view = self._buffer(name, np.shape(value))
+        view[...] = value
+        return a
+
     def _advection(self, q, ext, Fi_rel, Fj_rel, implicit: str = "skip"):
         """div(q (u - u_g)) per cell area: van Leer's limited upwind face values along the grid lines; the
         implicit j-faces (``grid.implicit_j``) left out (``implicit="skip"``: the line solve carries them) or
-        first-order upwind (``"upwind"``: the residual of a delta form whose line solve has their Jacobian)."""
-        # i-faces: minus side i-1, plus side i
-        qm1, q0 = np.roll(q, 1, axis=1), q
-        qm2, qp1 = np.roll(q, 2, axis=1), np.roll(q, -1, axis=1)
-        up = self._limited(qm1, q0, qm2)      # flow towards +i: upwind i-1
-        dn = self._limited(q0, qm1, qp1)      # flow towards -i: upwind i
-        fi = Fi_rel * np.where(Fi_rel > 0, up, dn)
-        # j-faces 1 .. nj: minus side ring j-1, plus side ring j (ext row r is ring r - 1)
-        lo, hi = ext[1:-2], ext[2:-1]               # rings j-1 and j for j = 1 .. nj
-        lo2, hi2 = ext[:-3], ext[3:]                # rings j-2 and j+1
-        upj = self._limited(lo, hi, lo2)
-        dnj = self._limited(hi, lo, hi2)
-        fj = np.zeros_like(Fj_rel)
-        fj[1:] = Fj_rel[1:] * np.where(Fj_rel[1:] > 0, upj, dnj)   # the wall face carries no relative flux
-        imp = self.grid.implicit_j
-        if implicit == "skip":
-            fj[imp] = 0.0
-        else:
-            fj[imp] = (Fj_rel * np.where(Fj_rel > 0, ext[:-2], ext[1:-1]))[imp]   # rings f-1 and f of face f
-        return (np.roll(fi, -1, axis=1) - fi + fj[1:] - fj[:-1]) / self.grid.area
+        first-order upwind (``"upwind"``: the residual of a delta form whose line solve has their Jacobian);
+        ``ext`` is q with the wall's reflection and the two ghost rings (``_ring_values``).  Kernel
+        ``kernels.curvilinear.advection``."""
+        import warp as wp
 
-    @staticmethod
-    def _limited(qu, qd, quu):
-        """Face value from the upwind cell qu towards the downwind qd, limited by the second upwind quu."""
-        dq = qd - qu
-        with np.errstate(divide="ignore", invalid="ignore"):
-            r = np.where(np.abs(dq) > 1e-300, (qu - quu) / np.where(np.abs(dq) > 1e-300, dq, 1.0), 0.0)
-        return qu + 0.5 * _van_leer(r) * dq
+        from kernels import curvilinear as _kc
+
+        g = self.grid
+        out, view = self._buffer("advection", q.shape)
+        wp.launch(_kc.advection, dim=g.nj, device="cpu",
+                  inputs=[self._warp("ext", ext), self._warp("Fi_rel", Fi_rel), self._warp("Fj_rel", Fj_rel),
+                          self._geo["implicit_j"], int(implicit == "upwind"), self._geo["area"], g.ni, out])
+        return view.copy()
 
     def set_eddy_viscosity(self, nu_t: np.ndarray) -> None:
         """The eddy viscosity of the cells (nj, ni), from a turbulence model: the momentum's diffusivity becomes
@@ -413,44 +420,41 @@ class CurvilinearFlow(FlowBase):
 
     def cell_gradient(self, q, q_wall_face, q_outer_face) -> tuple[np.ndarray, np.ndarray]:
         """grad q at the cell centres by Green-Gauss: interior faces the mean of their two cells, the wall and
-        outer faces the values given ((ni,) each)."""
-        g = self.grid
-        qi = 0.5 * (q + np.roll(q, 1, axis=1))
-        qj = np.vstack([q_wall_face[None], 0.5 * (q[1:] + q[:-1]), q_outer_face[None]])
-        out = []
-        for k in (0, 1):
-            fi = qi * g.Si[..., k]
-            fj = qj * g.Sj[..., k]
-            out.append((np.roll(fi, -1, axis=1) - fi + fj[1:] - fj[:-1]) / g.area)
-        return out[0], out[1]
+        outer faces the values given ((ni,) each).  Kernel ``kernels.curvilinear.cell_gradient``."""
+        import warp as wp
+
+        from kernels import curvilinear as _kc
+
+        g, geo = self.grid, self._geo
+        (gx, vx), (gy, vy) = self._buffer("grad_x", q.shape), self._buffer("grad_y", q.shape)
+        wp.launch(_kc.cell_gradient, dim=g.nj, device="cpu",
+                  inputs=[self._warp("q", q), self._warp("wall_face", q_wall_face),
+                          self._warp("outer_face", q_outer_face), geo["six"], geo["siy"], geo["sjx"], geo["sjy"],
+                          geo["area"], g.nj, g.ni, gx, gy])
+        return vx.copy(), vy.copy()
 
     def diffusion_parts(self, q, gam_i, gam_j, q_wall_face, q_wall_node, ghosts, w0=None, w1=None):
         """div(Gamma grad q) per cell area in three parts, Gamma on the faces (gam_i (nj, ni), gam_j (nj + 1, ni)):
         every face's cross term (beta, explicit), the alpha terms of the i-faces (around each ring) and of the
         j-faces (ring to ring, the wall and outer faces with their boundary values), both implicit; each as its
-        value now.  The wall face's normal gradient w0 (q0 - q_w) + w1 (q1 - q_w) (default: the quadratic
-        through the wall and the first two rings)."""
-        g = self.grid
-        w0 = g.wall_w0 if w0 is None else w0
-        w1 = g.wall_w1 if w1 is None else w1
-        # node values: wall nodes given; interior nodes the mean of four cells; outer nodes with ghost ring 1
-        ext = np.vstack([q, ghosts[:1]])                              # rings 0 .. nj (nj: ghost)
-        four = 0.25 * (ext[:-1] + np.roll(ext[:-1], 1, axis=1) + ext[1:] + np.roll(ext[1:], 1, axis=1))
-        nodes = np.vstack([q_wall_node[None], four])                  # (nj + 1, ni): node (j, i)
-        # i-faces: alpha (q_i - q_{i-1}) + beta (node (j+1, i) - node (j, i))
-        fi_normal = gam_i * g.alpha_i * (q - np.roll(q, 1, axis=1))
-        fi_cross = gam_i * g.beta_i * (nodes[1:] - nodes[:-1])
-        # j-faces: cross terms beta (node (j, i+1) - node (j, i)); normal alpha (above - below)
-        fj_cross = gam_j * g.beta_j * (np.roll(nodes, -1, axis=1) - nodes)
-        below = np.vstack([q_wall_face[None], q])
-        above = np.vstack([q, ghosts[:1]])
-        fj_normal = g.alpha_j * (above - below)
-        fj_normal[0] = g.alpha_j[0] * (w0 * (q[0] - q_wall_face) + w1 * (q[1] - q_wall_face))
-        fj_normal *= gam_j
-        cross = (np.roll(fi_cross, -1, axis=1) - fi_cross + fj_cross[1:] - fj_cross[:-1]) / g.area
-        around = (np.roll(fi_normal, -1, axis=1) - fi_normal) / g.area
-        rings = (fj_normal[1:] - fj_normal[:-1]) / g.area
-        return cross, around, rings
+        value now.  Face gradients as the module doc's (node values: the wall's given, the others the mean of the
+        four cells around, the outer nodes' with ghost ring 1); the wall face's normal gradient
+        w0 (q0 - q_w) + w1 (q1 - q_w) (default: the quadratic through the wall and the first two rings).  Kernel
+        ``kernels.curvilinear.diffusion_parts``."""
+        import warp as wp
+
+        from kernels import curvilinear as _kc
+
+        g, geo = self.grid, self._geo
+        w0 = self._w0 if w0 is None else self._warp("w0", w0)
+        w1 = self._w1 if w1 is None else self._warp("w1", w1)
+        parts = [self._buffer(name, q.shape) for name in ("cross", "around", "rings")]
+        wp.launch(_kc.diffusion_parts, dim=g.nj, device="cpu",
+                  inputs=[self._warp("q", q), self._warp("gam_i", gam_i), self._warp("gam_j", gam_j),
+                          self._warp("wall_face", q_wall_face), self._warp("wall_node", q_wall_node),
+                          self._warp("ghost", ghosts[0]), w0, w1, geo["alpha_i"], geo["beta_i"], geo["alpha_j"],
+                          geo["beta_j"], geo["area"], g.nj, g.ni, *(a for a, _ in parts)])
+        return tuple(view.copy() for _, view in parts)
 
     def _transpose_stress(self, u, v, wall_face, ghosts):
         """div(nu_t (grad u)^T) per cell area, both components (explicit; zero while laminar): the cells'
