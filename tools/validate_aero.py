@@ -46,7 +46,7 @@ NAMES = ("H1", "H2", "H3", "H4", "A1", "A2", "A3", "A4")
 
 
 # the preset's grid fields a run may replace (a grid study beyond the presets, docs/aero.md)
-GRID_FIELDS = ("cells_per_chord", "dy_over_dx", "background_coarsening")
+GRID_FIELDS = ("cells_per_chord", "dy_over_dx", "background_coarsening", "around_per_chord", "first_height", "growth")
 
 
 def plate_quality(quality: str, grid: str, turbulence: str = "laminar", reynolds: float | None = None,
@@ -182,6 +182,11 @@ def main(argv=None) -> int:
     ap.add_argument("--dy-over-dx", type=float, default=None, help="replace the preset's dy / dx at the section")
     ap.add_argument("--background-coarsening", type=int, default=None,
                     help="replace the preset's background cell / body cell (overset grid)")
+    ap.add_argument("--around-per-chord", type=float, default=None,
+                    help="body_fitted: O-grid nodes per chord of the outline (default 2 x cells per chord)")
+    ap.add_argument("--first-height", type=float, default=None,
+                    help="body_fitted: the wall cells' height, chords (default 0.1 / cells per chord)")
+    ap.add_argument("--growth", type=float, default=None, help="body_fitted: the O-grid's layer growth ratio (1.1)")
     ap.add_argument("--dofs", nargs="+", choices=["heave", "pitch"], default=["heave", "pitch"],
                     help="the runs per reduced velocity (default both; heave alone gives H1*, H4*, A1*, A4*)")
     ap.add_argument("--out", type=Path, default=Path("out/validate_aero.json"))
