@@ -462,6 +462,7 @@ class BodyFittedPair(RigidPair, FlowBase):
         self.t, self.n_steps = float(t), int(n_steps)
         self.body.outer._cache = {}   # (the model's nu_t below reads the boundary values at t)
         if self.turbulence is not LAMINAR:
+            self.turbulence._ghost_cache = None
             self.turbulence.body.restore({k[11:]: v for k, v in arrays.items() if k.startswith("turbulence/")})
         times = np.atleast_1d(arrays["psi_times"])
         self._psi_hist = [(float(tk), np.asarray(arrays[f"psi_{k}"])) for k, tk in enumerate(times)]
@@ -493,6 +494,7 @@ class BodyFittedSST:
         from .curvilinear_sst import CurvilinearSST
 
         self.pair = pair
+        self._ghost_cache = None   # (t, the ghost rings' k and omega then)
         og = pair.body.grid
         wall = SimpleNamespace(vertices=np.column_stack([og.x[0], og.y[0]]))
         self.background = KOmegaSST(pair.background, k_inf, omega_inf, "resolved",
@@ -502,12 +504,17 @@ class BodyFittedSST:
         pair.use_turbulence(self)
 
     def _ghosts(self, t: float):
-        """The O-grid's ghost rings' k and omega from the background's at their places at t."""
+        """The O-grid's ghost rings' k and omega from the background's at their places at t (kept for the next
+        call at the same t until the background's change: a sub-step asks three times)."""
+        if self._ghost_cache is not None and self._ghost_cache[0] == t:
+            return self._ghost_cache[1]
         pair, g = self.pair, self.pair.body.grid
         grid = pair.background.grid
         X, Y = pair.to_background(g.xg, g.yg, t)
-        return tuple(bilinear(s.interior(), grid.x_centres, grid.y_centres, X, Y)
-                     for s in (self.background.k, self.background.omega))
+        out = tuple(bilinear(s.interior(), grid.x_centres, grid.y_centres, X, Y)
+                    for s in (self.background.k, self.background.omega))
+        self._ghost_cache = (t, out)
+        return out
 
     def hole_cells(self, t: float):
         """Background cells (storage J, I) whose centres lie inside the hole's ring at t, their body
@@ -532,6 +539,7 @@ class BodyFittedSST:
         """The background's k and omega over the step both flows have just taken, its hole cells held at the
         O-grid's (transported already, in the O-grid's sub-steps)."""
         bg, body, t = self.background, self.body, self.pair.t
+        self._ghost_cache = None   # the background's k and omega change now
         bg.update()
         (J, I), xi, eta, solid = self.hole_cells(t)
         if J.size:

@@ -248,6 +248,7 @@ class CurvilinearFlow(FlowBase):
                      "sjx": const(grid.Sj[..., 0]), "sjy": const(grid.Sj[..., 1]),
                      "implicit_j": const(grid.implicit_j.astype(np.int32), wp.int32)}
         self._work = {}
+        self._gradients = None   # velocity_gradients' cache
 
     # --- operators ------------------------------------------------------------------------------
     def _node_matrix(self) -> sp.csr_matrix:
@@ -456,12 +457,25 @@ class CurvilinearFlow(FlowBase):
                           geo["beta_j"], geo["area"], g.nj, g.ni, *(a for a, _ in parts)])
         return tuple(view.copy() for _, view in parts)
 
-    def _transpose_stress(self, u, v, wall_face, ghosts):
-        """div(nu_t (grad u)^T) per cell area, both components (explicit; zero while laminar): the cells'
-        gradients averaged to the faces, nu_t on them as the momentum's (the wall face none)."""
+    def velocity_gradients(self, t: float) -> tuple[tuple[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]:
+        """((du/dx, du/dy), (dv/dx, dv/dy)) of the velocity now at the cell centres (:meth:`cell_gradient`: the
+        wall faces' the wall's velocity at t, the outer faces' the mean of the outer ring and ghost ring 1).  The
+        stress's transpose part and the turbulence model's strain both need them: kept until the velocity or t
+        changes (the arrays are the caller's to read, not to change)."""
+        c = self._gradients
+        if c is not None and c[0] is self.u and c[1] is self.v and c[2] == t:
+            return c[3]
+        (wfu, wfv), _, (gu, gv) = self._boundary(t)
+        out = tuple(self.cell_gradient(q, wf, 0.5 * (q[-1] + gh[0]))
+                    for q, wf, gh in ((self.u, wfu, gu), (self.v, wfv, gv)))
+        self._gradients = (self.u, self.v, t, out)
+        return out
+
+    def _transpose_stress(self, t: float):
+        """div(nu_t (grad u)^T) per cell area of the velocity now, both components (explicit; zero while laminar):
+        the cells' gradients averaged to the faces, nu_t on them as the momentum's (the wall face none)."""
         g = self.grid
-        outer = [0.5 * (q[-1] + gh[0]) for q, gh in zip((u, v), ghosts, strict=True)]
-        (ux, uy), (vx, vy) = (self.cell_gradient(q, wf, o) for q, wf, o in zip((u, v), wall_face, outer, strict=True))
+        (ux, uy), (vx, vy) = self.velocity_gradients(t)
         nt_i, nt_j = self.nu_i - self.nu, self.nu_j - self.nu
         out = []
         for a, b in ((ux, vx), (uy, vy)):   # row x: (du/dx, dv/dx) . S; row y: (du/dy, dv/dy) . S
@@ -537,15 +551,16 @@ class CurvilinearFlow(FlowBase):
         ghosts = self.outer.ghost_velocity(t)
         return wall_face, wall_node, ghosts
 
-    def _explicit(self, u, v, t):
-        """The explicit terms of both components at time t: -advection + explicit diffusion - Omega x u."""
-        g = self.grid
+    def _explicit(self, t):
+        """The explicit terms of both components of the velocity now (time t): -advection + explicit diffusion
+        - Omega x u."""
+        g, u, v = self.grid, self.u, self.v
         (wfu, wfv), (wnu, wnv), (gu, gv) = self._boundary(t)
         Fi_rel = self.Fi - self._grid_flux(t, g.xmi, g.Si)
         Fj_rel = self.Fj - self._grid_flux(t, g.xmj, g.Sj)
         Fj_rel[0] = 0.0
         om = self.frame_velocity(t)[2]
-        tr = self._transpose_stress(u, v, (wfu, wfv), (gu, gv)) if self._turbulent else (0.0, 0.0)
+        tr = self._transpose_stress(t) if self._turbulent else (0.0, 0.0)
         out = []
         for q, wf, wn, gh, frame, extra in ((u, wfu, wnu, gu, om * v, tr[0]), (v, wfv, wnv, gv, -om * u, tr[1])):
             adv = self._advection(q, self._ring_values(q, wf, gh), Fi_rel, Fj_rel)
@@ -604,7 +619,7 @@ class CurvilinearFlow(FlowBase):
     def _advance_flow(self, dt: float) -> None:
         g = self.grid
         t, t_new = self.t, self.t + dt
-        terms = self._explicit(self.u, self.v, t)
+        terms = self._explicit(t)
         H = [e for e, _, _ in terms]
         # BDF2 with extrapolated explicit terms (SBDF2: second order, and its implicit part damps the stiff
         # diffusion modes of the thin wall cells, where Crank-Nicolson's ring for long); a variable step

@@ -129,9 +129,7 @@ class CurvilinearSST:
     def update(self, t: float) -> None:
         """The model's coefficients and the flow's nu_t from the flow's velocity and k, omega now."""
         flow = self.flow
-        (wfu, wfv), _, (gu, gv) = flow._boundary(t)
-        (ux, uy), (vx, vy) = (flow.cell_gradient(q, wf, 0.5 * (q[-1] + gh[0]))
-                              for q, wf, gh in ((flow.u, wfu, gu), (flow.v, wfv, gv)))
+        (ux, uy), (vx, vy) = flow.velocity_gradients(t)
         s2 = 2.0 * (ux * ux + vy * vy) + (uy + vx) ** 2
         kg, wg = self.ghosts(t)
         (kw, _), (ww, _) = self._walls()
