@@ -1,5 +1,6 @@
 """Warp kernels of the body-fitted solver (bridge/cfd/curvilinear.py): the line solves of its implicit
-diffusion, one thread per grid line (storage [j, i]: ring j from the wall, i around the body, periodic).
+diffusion, one thread per grid line, and its explicit stencils (``advection``, ``diffusion_parts``,
+``cell_gradient``), one thread per ring (storage [j, i]: ring j from the wall, i around the body, periodic).
 
 ``line_solve_rings``: along each line i, (I + diag - c L_j) x = r with L_j the ring-to-ring diffusion and
   upwind advection (L_j x)_j = k_lo[j] (x[j-1] - x[j]) + k_hi[j] (x[j+1] - x[j]) (k: c nu alpha / area and

@@ -23,7 +23,9 @@ volume fluxes F = u . S on the faces): the divergence of a cell is the sum of it
 gradient comes from the two cells beside it (difference along d, the line between their centres) and the
 face's two nodes (difference along the face, t; node values the mean of the four cells around), so that
 grad q . S = alpha (q_E - q_P) + beta (q_n1 - q_n0) with alpha, beta from the face's geometry: the full
-metric, second order on smooth grids, and a nine-point pressure stencil.
+metric, second order on smooth grids, and a nine-point pressure stencil.  The explicit stencils (advection,
+diffusion, cell gradients) and the line solves are Warp kernels (kernels/curvilinear.py); the pressure's
+constant matrix is factorised once by SuperLU.
 
 Time step: second-order backward differences (BDF2) with the explicit terms extrapolated from the last two
 steps (SBDF2; Ascher, Ruuth and Wetton 1995) - advection (van Leer's limited upwinding along the grid lines),
