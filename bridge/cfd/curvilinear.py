@@ -213,6 +213,9 @@ class CurvilinearFlow(FlowBase):
         if not 0 < cfl <= 1.0:
             raise ValueError(f"cfl: allowed (0, 1], got {cfl}")
         self.grid, self.nu, self.motion, self.cfl, self.rho, self.fourier = grid, float(nu), motion, cfl, rho, fourier
+        self._gradients = None   # the caches of velocity_gradients, relative_fluxes and frame_velocity
+        self._relative = None
+        self._frame = None
         self.outer = outer if outer is not None else Farfield()
         self.outer.attach(self)
         self.turbulence = LAMINAR
@@ -250,7 +253,6 @@ class CurvilinearFlow(FlowBase):
                      "sjx": const(grid.Sj[..., 0]), "sjy": const(grid.Sj[..., 1]),
                      "implicit_j": const(grid.implicit_j.astype(np.int32), wp.int32)}
         self._work = {}
-        self._gradients = None   # velocity_gradients' cache
 
     # --- operators ------------------------------------------------------------------------------
     def _node_matrix(self) -> sp.csr_matrix:
@@ -348,10 +350,15 @@ class CurvilinearFlow(FlowBase):
 
     # --- boundary values --------------------------------------------------------------------------
     def frame_velocity(self, t: float) -> tuple[float, float, float]:
-        """(R^T V_O, Omega): the grid's translation in its own axes and its rotation rate."""
+        """(R^T V_O, Omega): the grid's translation in its own axes and its rotation rate (the last time's
+        kept: a step asks for a few times a dozen times over)."""
+        if self._frame is not None and self._frame[0] == t:
+            return self._frame[1]
         u, v, om = self.motion.velocity(t)
         ub, vb = _rot(self.motion.pose(t)[2]).T @ np.array([u, v])
-        return float(ub), float(vb), float(om)
+        out = (float(ub), float(vb), float(om))
+        self._frame = (t, out)
+        return out
 
     def _grid_velocity(self, t, px, py):
         ub, vb, om = self.frame_velocity(t)
@@ -360,6 +367,20 @@ class CurvilinearFlow(FlowBase):
     def _grid_flux(self, t, xm, S):
         ux, uy = self._grid_velocity(t, xm[..., 0], xm[..., 1])
         return ux * S[..., 0] + uy * S[..., 1]
+
+    def relative_fluxes(self, t: float) -> tuple[np.ndarray, np.ndarray]:
+        """The face fluxes now relative to the grid's own motion at t, (nj, ni) through the i-faces and
+        (nj + 1, ni) through the j-faces, the wall face's zero; kept until the fluxes or t change (the arrays are
+        the caller's to read, not to change)."""
+        c = self._relative
+        if c is not None and c[0] is self.Fi and c[1] is self.Fj and c[2] == t:
+            return c[3]
+        g = self.grid
+        Fi_rel = self.Fi - self._grid_flux(t, g.xmi, g.Si)
+        Fj_rel = self.Fj - self._grid_flux(t, g.xmj, g.Sj)
+        Fj_rel[0] = 0.0
+        self._relative = (self.Fi, self.Fj, t, (Fi_rel, Fj_rel))
+        return Fi_rel, Fj_rel
 
     # --- the explicit terms ---------------------------------------------------------------------
     def _ring_values(self, q, q_wall_face, ghosts):
@@ -556,11 +577,9 @@ class CurvilinearFlow(FlowBase):
     def _explicit(self, t):
         """The explicit terms of both components of the velocity now (time t): -advection + explicit diffusion
         - Omega x u."""
-        g, u, v = self.grid, self.u, self.v
+        u, v = self.u, self.v
         (wfu, wfv), (wnu, wnv), (gu, gv) = self._boundary(t)
-        Fi_rel = self.Fi - self._grid_flux(t, g.xmi, g.Si)
-        Fj_rel = self.Fj - self._grid_flux(t, g.xmj, g.Sj)
-        Fj_rel[0] = 0.0
+        Fi_rel, Fj_rel = self.relative_fluxes(t)
         om = self.frame_velocity(t)[2]
         tr = self._transpose_stress(t) if self._turbulent else (0.0, 0.0)
         out = []
@@ -606,8 +625,8 @@ class CurvilinearFlow(FlowBase):
     def _flow_dt(self) -> float:
         g = self.grid
         t = self.t
-        Fi_rel = np.abs(self.Fi - self._grid_flux(t, g.xmi, g.Si))
-        Fj_rel = np.where(g.implicit_j, 0.0, np.abs(self.Fj - self._grid_flux(t, g.xmj, g.Sj)))
+        Fi_rel, Fj_rel = self.relative_fluxes(t)
+        Fi_rel, Fj_rel = np.abs(Fi_rel), np.where(g.implicit_j, 0.0, np.abs(Fj_rel))
         rate = (Fi_rel + np.roll(Fi_rel, -1, axis=1) + Fj_rel[1:] + Fj_rel[:-1]) / (2 * g.area)
         conv = float(rate.max()) / self.cfl
         # the explicit cross-derivative diffusion (skewed cells only; the rest of the diffusion is implicit); the
@@ -637,8 +656,7 @@ class CurvilinearFlow(FlowBase):
         (wfu1, wfv1), _, (gu1, gv1) = self._boundary(t_new)
         gpx = (self._Gcx @ self.p.ravel()).reshape(self.u.shape)
         gpy = (self._Gcy @ self.p.ravel()).reshape(self.u.shape)
-        Fj_rel = self.Fj - self._grid_flux(t, g.xmj, g.Sj)   # the implicit j-faces' advection: by the fluxes now
-        Fj_rel[0] = 0.0
+        Fj_rel = self.relative_fluxes(t)[1]   # the implicit j-faces' advection: by the fluxes now
         wall_k = self.nu_j[0] * g.alpha_j[0] * (g.wall_w0 + g.wall_w1) / g.area[0]
         top_k = self.nu_j[-1] * g.alpha_j[-1] / g.area[-1]
         new = []

@@ -168,11 +168,9 @@ class CurvilinearSST:
     def transport(self, dt: float) -> None:
         """k and omega over the step the flow has just taken (module doc), then nu_t for its next."""
         flow = self.flow
-        g, t = flow.grid, flow.t
+        t = flow.t
         self.update(t)
-        Fi_rel = flow.Fi - flow._grid_flux(t, g.xmi, g.Si)
-        Fj_rel = flow.Fj - flow._grid_flux(t, g.xmj, g.Sj)
-        Fj_rel[0] = 0.0
+        Fi_rel, Fj_rel = flow.relative_fluxes(t)
         kg, wg = self.ghosts(t)
         kw, ww = self._walls()
         c = _C
