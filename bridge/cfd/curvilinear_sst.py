@@ -123,19 +123,30 @@ class CurvilinearSST:
         return (np.zeros(ni), np.zeros(ni)), (ow, 0.5 * (ow + np.roll(ow, 1)))
 
     # --- coefficients ---------------------------------------------------------------------------------
-    def update(self, t: float) -> None:
-        """The model's coefficients and the flow's nu_t from the flow's velocity and k, omega now."""
+    def update(self, t: float, hand_on: bool = True) -> None:
+        """The model's coefficients from the flow's velocity and k, omega now, and (``hand_on``) the flow's nu_t."""
         flow = self.flow
-        (ux, uy), (vx, vy) = flow.velocity_gradients(t)
-        s2 = 2.0 * (ux * ux + vy * vy) + (uy + vx) ** 2
         kg, wg = self.ghosts(t)
         (kw, _), (ww, _) = self._walls()
         kx, ky = flow.cell_gradient(self.k, kw, 0.5 * (self.k[-1] + kg[0]))
         wx, wy = flow.cell_gradient(self.omega, ww, 0.5 * (self.omega[-1] + wg[0]))
-        nu_t, self.f1, self.k_terms, self.w_terms = sst_terms(self.k, self.omega, s2, kx * wx + ky * wy,
-                                                              self.wall_distance, self.nu, flow)
-        self.nu_t = nu_t
-        flow.set_eddy_viscosity(nu_t)
+        self.nu_t, self.f1, self.k_terms, self.w_terms = sst_terms(self.k, self.omega, self._strain(t),
+                                                                   kx * wx + ky * wy, self.wall_distance, self.nu,
+                                                                   flow)
+        if hand_on:
+            flow.set_eddy_viscosity(self.nu_t)
+
+    def _strain(self, t: float) -> np.ndarray:
+        """S^2 = 2 S_ij S_ij of the flow's velocity now."""
+        (ux, uy), (vx, vy) = self.flow.velocity_gradients(t)
+        return 2.0 * (ux * ux + vy * vy) + (uy + vx) ** 2
+
+    def _hand_on(self, t: float) -> None:
+        """The flow's nu_t from k and omega now: all of :meth:`update` that the flow's next step reads (nu_t does
+        not depend on the cross diffusion, so grad k . grad omega is left out); the rest waits for the next
+        transport, which starts with :meth:`update`."""
+        self.nu_t = sst_terms(self.k, self.omega, self._strain(t), 0.0, self.wall_distance, self.nu, self.flow)[0]
+        self.flow.set_eddy_viscosity(self.nu_t)
 
     def _face_diffusivity(self, sigma_1: float, sigma_2: float):
         """nu + sigma nu_t on the i- and j-faces: the flow's rule for nu_t (``eddy_faces``) but on the outer
@@ -166,7 +177,7 @@ class CurvilinearSST:
         """k and omega over the step the flow has just taken (module doc), then nu_t for its next."""
         flow = self.flow
         t = flow.t
-        self.update(t)
+        self.update(t, hand_on=False)   # the flow has stepped: the coefficients from its new velocity
         Fi_rel, Fj_rel = flow.relative_fluxes(t)
         kg, wg = self.ghosts(t)
         kw, ww = self._walls()
@@ -181,7 +192,7 @@ class CurvilinearSST:
             new.append(q + dq)
         self.k = np.maximum(new[0], 0.0)
         self.omega = np.maximum(new[1], 1e-6 * self.omega_inf)
-        self.update(t)
+        self._hand_on(t)
 
     def stable_dt(self) -> float:
         """None of its own beyond the flow's: advection has the flow's Courant number, the rest is implicit but
