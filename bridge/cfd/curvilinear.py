@@ -216,6 +216,7 @@ class CurvilinearFlow(FlowBase):
         self._gradients = None   # the caches of velocity_gradients, relative_fluxes and frame_velocity
         self._relative = None
         self._frame = None
+        self._p_gradients = None
         self.outer = outer if outer is not None else Farfield()
         self.outer.attach(self)
         self.turbulence = LAMINAR
@@ -344,6 +345,11 @@ class CurvilinearFlow(FlowBase):
             return sp.csr_matrix((np.r_[1 - w, w], (np.r_[np.arange(m), np.arange(m)], np.r_[P, E])), shape=(m, n))
         self._Ii = weights(g.xmi, P_i, E_i)
         self._Ij = weights(g.xmj[1:nj], P_j, E_j)
+        # the same stacked, so that a projection makes four sparse products instead of twelve: the interior
+        # faces' interpolation (i-faces, then j-faces) and every gradient of a cell field (the faces', then the
+        # centres' x and y)
+        self._I_faces = sp.vstack([self._Ii, self._Ij]).tocsr()
+        self._G_all = sp.vstack([self._Gi, self._Gj, self._Gcx, self._Gcy]).tocsr()
         self._Nmat = N
         # the grid's own velocity at the face midpoints is Vb + Omega x xm: its flux through each face
         self._faces_i, self._faces_j = (P_i, E_i, n0_i, n1_i), (P_j, E_j, n0_j, n1_j)
@@ -593,17 +599,19 @@ class CurvilinearFlow(FlowBase):
         """Face fluxes of (us, vs) with the pressure's face gradient put back, the projection, and the
         corrected centres, fluxes and pressure (module doc)."""
         g, nj, ni = self.grid, self.grid.nj, self.grid.ni
-        p = self.p.ravel()
+        n, m = nj * ni, (nj - 1) * ni            # cells (and i-faces), interior j-faces
         if accumulate:
-            uh = us.ravel() + dt * (self._Gcx @ p)
-            vh = vs.ravel() + dt * (self._Gcy @ p)
+            gp = self._gradients_of_p()
+            uh = us.ravel() + dt * gp[n + m:2 * n + m]
+            vh = vs.ravel() + dt * gp[2 * n + m:]
         else:
             uh, vh = us.ravel(), vs.ravel()
-        Fi = (self._Ii @ uh) * g.Si[..., 0].ravel() + (self._Ii @ vh) * g.Si[..., 1].ravel()
-        Fj_in = (self._Ij @ uh) * g.Sj[1:nj, :, 0].ravel() + (self._Ij @ vh) * g.Sj[1:nj, :, 1].ravel()
+        uv = self._I_faces @ np.column_stack([uh, vh])
+        Fi = uv[:n, 0] * g.Si[..., 0].ravel() + uv[:n, 1] * g.Si[..., 1].ravel()
+        Fj_in = uv[n:, 0] * g.Sj[1:nj, :, 0].ravel() + uv[n:, 1] * g.Sj[1:nj, :, 1].ravel()
         if accumulate:
-            Fi -= dt * (self._Gi @ p)
-            Fj_in -= dt * (self._Gj @ p)
+            Fi -= dt * gp[:n]
+            Fj_in -= dt * gp[n:n + m]
         Fj = np.empty((nj + 1, ni))
         Fj[0] = self._grid_flux(t_new, g.xmj[0], g.Sj[0])
         Fj[1:nj] = Fj_in.reshape(nj - 1, ni)
@@ -614,11 +622,12 @@ class CurvilinearFlow(FlowBase):
         rhs[0] = 0.0
         # L phi = D G phi (outflow of the gradient's flux) = div / dt
         phi = self._poisson.solve(rhs)
-        Fi -= dt * (self._Gi @ phi).reshape(nj, ni)
-        Fj[1:nj] -= dt * (self._Gj @ phi).reshape(nj - 1, ni)
+        gphi = self._G_all @ phi
+        Fi -= dt * gphi[:n].reshape(nj, ni)
+        Fj[1:nj] -= dt * gphi[n:n + m].reshape(nj - 1, ni)
         self.Fi, self.Fj = Fi, Fj
-        self.u = us - dt * (self._Gcx @ phi).reshape(nj, ni)
-        self.v = vs - dt * (self._Gcy @ phi).reshape(nj, ni)
+        self.u = us - dt * gphi[n + m:2 * n + m].reshape(nj, ni)
+        self.v = vs - dt * gphi[2 * n + m:].reshape(nj, ni)
         self.p = (self.p + phi.reshape(nj, ni)) if accumulate else np.zeros((nj, ni))
         self.last_divergence = np.abs(np.roll(Fi, -1, axis=1) - Fi + Fj[1:] - Fj[:-1]).max()
 
@@ -654,8 +663,7 @@ class CurvilinearFlow(FlowBase):
             ex = [(1 + w) * h - w * h0 for h, h0 in zip(H, self._H, strict=True)]
         c = dt / a0
         (wfu1, wfv1), _, (gu1, gv1) = self._boundary(t_new)
-        gpx = (self._Gcx @ self.p.ravel()).reshape(self.u.shape)
-        gpy = (self._Gcy @ self.p.ravel()).reshape(self.u.shape)
+        gpx, gpy = self.pressure_gradient()
         Fj_rel = self.relative_fluxes(t)[1]   # the implicit j-faces' advection: by the fluxes now
         wall_k = self.nu_j[0] * g.alpha_j[0] * (g.wall_w0 + g.wall_w1) / g.area[0]
         top_k = self.nu_j[-1] * g.alpha_j[-1] / g.area[-1]
@@ -675,9 +683,20 @@ class CurvilinearFlow(FlowBase):
         self.t, self.n_steps, self.last_dt = t_new, self.n_steps + 1, dt
         self.last_force = self._force(t_new)
 
+    def _gradients_of_p(self) -> np.ndarray:
+        """The pressure's face gradients (times S; i-faces, interior j-faces) and its centres' gradient (x, y),
+        one vector; kept until p changes (a step reads it twice)."""
+        c = self._p_gradients
+        if c is None or c[0] is not self.p:
+            c = self._p_gradients = (self.p, self._G_all @ self.p.ravel())
+        return c[1]
+
     def pressure_gradient(self) -> tuple[np.ndarray, np.ndarray]:
         """grad p at the cell centres (Green-Gauss, the boundary faces' values extrapolated), body axes."""
-        return ((self._Gcx @ self.p.ravel()).reshape(self.p.shape), (self._Gcy @ self.p.ravel()).reshape(self.p.shape))
+        nj, ni = self.p.shape
+        n, m = nj * ni, (nj - 1) * ni
+        gp = self._gradients_of_p()
+        return gp[n + m:2 * n + m].reshape(nj, ni).copy(), gp[2 * n + m:].reshape(nj, ni).copy()
 
     # --- loads ------------------------------------------------------------------------------------
     def wall_pressure(self) -> np.ndarray:
