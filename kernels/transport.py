@@ -266,49 +266,6 @@ def _fill_ghosts(a: wp.array2d(dtype=wp.float64), J: int, g: int, nx: int, ny: i
                 a[g + ny - 1 + m, I] = a[g + ny - 1, I]
 
 
-@wp.func
-def sst_point(s2: wp.float64, k: wp.float64, w: wp.float64, grad_kw: wp.float64, d: wp.float64, nu: wp.float64):
-    """The SST-2003 model at one cell (bridge/cfd/turbulence.py has the equations), from the strain S^2, k, omega,
-    grad k . grad omega and the wall distance d: nu_t, the blending F1, k's source S_e = min(nu_t S^2,
-    10 beta* k omega) and sink rate beta* omega, omega's source gamma S^2 + max(CD, 0) and sink rate
-    beta omega + max(-CD, 0) / omega, CD = 2 (1 - F1) sigma_w2 grad k . grad omega / omega.  Both grids' models
-    use it (``sst_coefficients``, ``sst_cells``)."""
-    one = wp.float64(1.0)
-    two = wp.float64(2.0)
-    kk = wp.max(k, wp.float64(0.0))
-    ww = wp.max(w, wp.float64(1.0e-30))
-    cd_kw = wp.max(two * SST_SIGMA_W2 * grad_kw / ww, wp.float64(1.0e-10))
-    sk = wp.sqrt(kk)
-    arg1 = wp.min(wp.max(sk / (SST_BETA_STAR * ww * d), wp.float64(500.0) * nu / (d * d * ww)),
-                  wp.float64(4.0) * SST_SIGMA_W2 * kk / (cd_kw * d * d))
-    f1 = wp.tanh(arg1 * arg1 * arg1 * arg1)
-    arg2 = wp.max(two * sk / (SST_BETA_STAR * ww * d), wp.float64(500.0) * nu / (d * d * ww))
-    f2 = wp.tanh(arg2 * arg2)
-    nut = SST_A1 * kk / wp.max(SST_A1 * ww, wp.sqrt(s2) * f2)
-    beta = f1 * SST_BETA1 + (one - f1) * SST_BETA2
-    gamma = f1 * SST_GAMMA1 + (one - f1) * SST_GAMMA2
-    cross = two * (one - f1) * SST_SIGMA_W2 * grad_kw / ww
-    return (nut, f1, wp.min(nut * s2, wp.float64(10.0) * SST_BETA_STAR * kk * ww), SST_BETA_STAR * ww,
-            gamma * s2 + wp.max(cross, wp.float64(0.0)), beta * ww + wp.max(-cross, wp.float64(0.0)) / ww)
-
-
-@wp.kernel
-def sst_cells(s2: wp.array(dtype=wp.float64), k: wp.array(dtype=wp.float64), w: wp.array(dtype=wp.float64),
-              grad_kw: wp.array(dtype=wp.float64), dist: wp.array(dtype=wp.float64), nu: wp.float64,
-              nut: wp.array(dtype=wp.float64), f1: wp.array(dtype=wp.float64), src_k: wp.array(dtype=wp.float64),
-              snk_k: wp.array(dtype=wp.float64), src_w: wp.array(dtype=wp.float64),
-              snk_w: wp.array(dtype=wp.float64)):
-    """``sst_point`` on cells given as flat arrays (the O-grid's model, bridge/cfd/curvilinear_sst.py)."""
-    c = wp.tid()
-    a, b, sk, ik, sw, iw = sst_point(s2[c], k[c], w[c], grad_kw[c], dist[c], nu)
-    nut[c] = a
-    f1[c] = b
-    src_k[c] = sk
-    snk_k[c] = ik
-    src_w[c] = sw
-    snk_w[c] = iw
-
-
 @wp.kernel
 def sst_coefficients(u: wp.array2d(dtype=wp.float64), v: wp.array2d(dtype=wp.float64),
                      k: wp.array2d(dtype=wp.float64), w: wp.array2d(dtype=wp.float64),
@@ -321,13 +278,15 @@ def sst_coefficients(u: wp.array2d(dtype=wp.float64), v: wp.array2d(dtype=wp.flo
                      snk_w: wp.array2d(dtype=wp.float64)):
     """The SST-2003 model's coefficients on the cells of storage row row0 + tid (and that row's ghost
     columns; the first and last interior rows also fill the ghost rows), for the transport of
-    ``kernels.transport.scalar_stage`` (bridge/cfd/turbulence.py has the equations): nu_eff = nu + nu_t,
-    k's Gamma = nu + sigma_k nu_t, omega's Gamma = nu + sigma_w nu_t, and the sources and sink rates of
-    ``sst_point``."""
+    ``kernels.transport.scalar_stage`` (bridge/cfd/turbulence.py has the equations):
+    nu_eff = nu + nu_t; k: Gamma = nu + sigma_k nu_t, S_e = min(nu_t S^2, 10 beta* k omega),
+    S_i = beta* omega; omega: Gamma = nu + sigma_w nu_t, S_e = gamma S^2 + max(CD, 0),
+    S_i = beta omega + max(-CD, 0) / omega, CD = 2 (1 - F1) sigma_w2 grad k . grad omega / omega."""
     J = row0 + wp.tid()
     half = wp.float64(0.5)
     one = wp.float64(1.0)
     two = wp.float64(2.0)
+    tiny = wp.float64(1.0e-30)
     idx = one / dx
     ihc = one / hy_c[J]
     iyy = one / (yc[J + 1] - yc[J - 1])
@@ -337,18 +296,34 @@ def sst_coefficients(u: wp.array2d(dtype=wp.float64), v: wp.array2d(dtype=wp.flo
         dudy = half * ((u[J + 1, I] + u[J + 1, I + 1]) - (u[J - 1, I] + u[J - 1, I + 1])) * iyy
         dvdx = half * ((v[J, I + 1] + v[J + 1, I + 1]) - (v[J, I - 1] + v[J + 1, I - 1])) * half * idx
         s2 = two * (dudx * dudx + dvdy * dvdy) + (dudy + dvdx) * (dudy + dvdx)
+        kk = wp.max(k[J, I], wp.float64(0.0))
+        ww = wp.max(w[J, I], tiny)
+        d = dist[J, I]
         dkx = (k[J, I + 1] - k[J, I - 1]) * half * idx
         dky = (k[J + 1, I] - k[J - 1, I]) * iyy
         dwx = (w[J, I + 1] - w[J, I - 1]) * half * idx
         dwy = (w[J + 1, I] - w[J - 1, I]) * iyy
-        nut, f1, sk, ik, sw, iw = sst_point(s2, k[J, I], w[J, I], dkx * dwx + dky * dwy, dist[J, I], nu)
+        grad_kw = dkx * dwx + dky * dwy
+        cd_kw = wp.max(two * SST_SIGMA_W2 * grad_kw / ww, wp.float64(1.0e-10))
+        sk = wp.sqrt(kk)
+        arg1 = wp.min(wp.max(sk / (SST_BETA_STAR * ww * d), wp.float64(500.0) * nu / (d * d * ww)),
+                      wp.float64(4.0) * SST_SIGMA_W2 * kk / (cd_kw * d * d))
+        f1 = wp.tanh(arg1 * arg1 * arg1 * arg1)
+        arg2 = wp.max(two * sk / (SST_BETA_STAR * ww * d), wp.float64(500.0) * nu / (d * d * ww))
+        f2 = wp.tanh(arg2 * arg2)
+        nut = SST_A1 * kk / wp.max(SST_A1 * ww, wp.sqrt(s2) * f2)
+        sigma_k = f1 * SST_SIGMA_K1 + (one - f1) * SST_SIGMA_K2
+        sigma_w = f1 * SST_SIGMA_W1 + (one - f1) * SST_SIGMA_W2
+        beta = f1 * SST_BETA1 + (one - f1) * SST_BETA2
+        gamma = f1 * SST_GAMMA1 + (one - f1) * SST_GAMMA2
+        cross = two * (one - f1) * SST_SIGMA_W2 * grad_kw / ww
         nu_eff[J, I] = nu + nut
-        gam_k[J, I] = nu + (f1 * SST_SIGMA_K1 + (one - f1) * SST_SIGMA_K2) * nut
-        gam_w[J, I] = nu + (f1 * SST_SIGMA_W1 + (one - f1) * SST_SIGMA_W2) * nut
-        src_k[J, I] = sk
-        snk_k[J, I] = ik
-        src_w[J, I] = sw
-        snk_w[J, I] = iw
+        gam_k[J, I] = nu + sigma_k * nut
+        gam_w[J, I] = nu + sigma_w * nut
+        src_k[J, I] = wp.min(nut * s2, wp.float64(10.0) * SST_BETA_STAR * kk * ww)
+        snk_k[J, I] = SST_BETA_STAR * ww
+        src_w[J, I] = gamma * s2 + wp.max(cross, wp.float64(0.0))
+        snk_w[J, I] = beta * ww + wp.max(-cross, wp.float64(0.0)) / ww
     _fill_ghosts(nu_eff, J, g, nx, ny)
     _fill_ghosts(gam_k, J, g, nx, ny)
     _fill_ghosts(gam_w, J, g, nx, ny)

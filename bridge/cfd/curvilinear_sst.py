@@ -40,7 +40,8 @@ from .turbulence import BETA_1
 
 __all__ = ["CurvilinearSST", "first_height_for"]
 
-_C = {name: float(getattr(_t, f"SST_{name}").value) for name in ("SIGMA_K1", "SIGMA_K2", "SIGMA_W1", "SIGMA_W2")}
+_C = {name: float(getattr(_t, f"SST_{name}").value) for name in
+      ("BETA_STAR", "A1", "SIGMA_K1", "SIGMA_K2", "SIGMA_W1", "SIGMA_W2", "BETA1", "BETA2", "GAMMA1", "GAMMA2")}
 
 
 def first_height_for(reynolds: float, y_plus: float = 1.0, chord: float = 1.0) -> float:
@@ -52,26 +53,28 @@ def first_height_for(reynolds: float, y_plus: float = 1.0, chord: float = 1.0) -
     return y_plus * chord / (reynolds * math.sqrt(cf / 2.0))
 
 
-def sst_terms(k, w, s2, grad_kw, d, nu, flow=None):
-    """The SST-2003 coefficients of cells (the Cartesian model's: ``kernels.transport.sst_point``, kernel
-    ``sst_cells``): nu_t, the blending F1, k's source and sink rate, omega's source and sink rate (destruction
-    and the negative part of the cross diffusion, implicit).  ``flow``: a CurvilinearFlow whose work arrays carry
-    the kernel's inputs and outputs (default: arrays made for the call)."""
-    import warp as wp
-
-    shape = np.shape(k)
-    flat = [np.ascontiguousarray(np.broadcast_to(a, shape), dtype=np.float64).ravel() for a in (s2, k, w, grad_kw, d)]
-    n = flat[0].size
-    if flow is None:
-        ins = [wp.array(a, dtype=wp.float64, device="cpu") for a in flat]
-        outs = [wp.zeros(n, dtype=wp.float64, device="cpu") for _ in range(6)]
-        views = [o.numpy() for o in outs]
-    else:
-        ins = [flow._warp(f"sst_in_{m}", a) for m, a in enumerate(flat)]
-        work = [flow._buffer(f"sst_out_{m}", (n,)) for m in range(6)]
-        outs, views = [a for a, _ in work], [v for _, v in work]
-    wp.launch(_t.sst_cells, dim=n, device="cpu", inputs=[*ins, float(nu), *outs])
-    nu_t, f1, src_k, snk_k, src_w, snk_w = (v.reshape(shape).copy() for v in views)
+def sst_terms(k, w, s2, grad_kw, d, nu):
+    """The SST-2003 coefficients of cells (turbulence.py's equations; the same as
+    ``kernels.transport.sst_coefficients``): nu_t, the blending F1, k's source and sink rate, omega's source and
+    sink rate (destruction and the negative part of the cross diffusion, implicit)."""
+    c = _C
+    kk = np.maximum(k, 0.0)
+    ww = np.maximum(w, 1e-30)
+    cd = np.maximum(2.0 * c["SIGMA_W2"] * grad_kw / ww, 1e-10)
+    sk = np.sqrt(kk)
+    arg1 = np.minimum(np.maximum(sk / (c["BETA_STAR"] * ww * d), 500.0 * nu / (d * d * ww)),
+                      4.0 * c["SIGMA_W2"] * kk / (cd * d * d))
+    f1 = np.tanh(arg1 ** 4)
+    arg2 = np.maximum(2.0 * sk / (c["BETA_STAR"] * ww * d), 500.0 * nu / (d * d * ww))
+    f2 = np.tanh(arg2 ** 2)
+    nu_t = c["A1"] * kk / np.maximum(c["A1"] * ww, np.sqrt(s2) * f2)
+    beta = f1 * c["BETA1"] + (1 - f1) * c["BETA2"]
+    gamma = f1 * c["GAMMA1"] + (1 - f1) * c["GAMMA2"]
+    cross = 2.0 * (1 - f1) * c["SIGMA_W2"] * grad_kw / ww
+    src_k = np.minimum(nu_t * s2, 10.0 * c["BETA_STAR"] * kk * ww)
+    snk_k = c["BETA_STAR"] * ww
+    src_w = gamma * s2 + np.maximum(cross, 0.0)
+    snk_w = beta * ww + np.maximum(-cross, 0.0) / ww
     return nu_t, f1, (src_k, snk_k), (src_w, snk_w)
 
 
@@ -131,8 +134,7 @@ class CurvilinearSST:
         kx, ky = flow.cell_gradient(self.k, kw, 0.5 * (self.k[-1] + kg[0]))
         wx, wy = flow.cell_gradient(self.omega, ww, 0.5 * (self.omega[-1] + wg[0]))
         self.nu_t, self.f1, self.k_terms, self.w_terms = sst_terms(self.k, self.omega, self._strain(t),
-                                                                   kx * wx + ky * wy, self.wall_distance, self.nu,
-                                                                   flow)
+                                                                   kx * wx + ky * wy, self.wall_distance, self.nu)
         if hand_on:
             flow.set_eddy_viscosity(self.nu_t)
 
@@ -145,7 +147,7 @@ class CurvilinearSST:
         """The flow's nu_t from k and omega now: all of :meth:`update` that the flow's next step reads (nu_t does
         not depend on the cross diffusion, so grad k . grad omega is left out); the rest waits for the next
         transport, which starts with :meth:`update`."""
-        self.nu_t = sst_terms(self.k, self.omega, self._strain(t), 0.0, self.wall_distance, self.nu, self.flow)[0]
+        self.nu_t = sst_terms(self.k, self.omega, self._strain(t), 0.0, self.wall_distance, self.nu)[0]
         self.flow.set_eddy_viscosity(self.nu_t)
 
     def _face_diffusivity(self, sigma_1: float, sigma_2: float):
