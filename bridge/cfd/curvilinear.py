@@ -239,14 +239,11 @@ class CurvilinearFlow(FlowBase):
         from ..warp_setup import init_warp
 
         init_warp("cpu")
-        z = lambda: wp.zeros((nj, ni), dtype=wp.float64, device="cpu")  # noqa: E731
-        # the line solves' work arrays and coefficients, allocated once (the coefficients are copied in through
-        # the arrays' NumPy views: a new Warp array per coefficient and call cost a tenth of a step)
-        self._line_buffers = {name: z() for name in ("cp_i", "y", "z", "x_i", "cp_j", "x_j",
-                                                     "k_m", "k_p", "rhs", "k_lo", "k_hi", "diag")}
         self._w0 = wp.array(grid.wall_w0, dtype=wp.float64, device="cpu")
         self._w1 = wp.array(grid.wall_w1, dtype=wp.float64, device="cpu")
-        # the explicit stencils' constant geometry and their work arrays (with their NumPy views)
+        # the kernels' constant geometry, and their work arrays with their NumPy views (``_buffer``: allocated once;
+        # the inputs are copied in through the views, where a new Warp array per input and call cost a tenth of a
+        # step)
         const = lambda a, dtype=wp.float64: wp.array(np.ascontiguousarray(a), dtype=dtype, device="cpu")  # noqa: E731
         self._geo = {"area": const(grid.area), "alpha_i": const(grid.alpha_i), "beta_i": const(grid.beta_i),
                      "alpha_j": const(grid.alpha_j), "beta_j": const(grid.beta_j),
@@ -524,16 +521,18 @@ class CurvilinearFlow(FlowBase):
         from kernels import curvilinear as _kc
 
         nj, ni = self.grid.nj, self.grid.ni
-        w = self._line_buffers
-        for name, value in (("k_m", k_m), ("k_p", k_p), ("rhs", rhs), ("k_lo", k_lo), ("k_hi", k_hi), ("diag", diag)):
+        given = {"k_m": k_m, "k_p": k_p, "rhs": rhs, "k_lo": k_lo, "k_hi": k_hi, "diag": diag}
+        for name, value in given.items():
             if np.shape(value) != (nj, ni):
                 raise ValueError(f"line_solve: {name} has shape {np.shape(value)}, the grid's is {(nj, ni)}")
-            w[name].numpy()[...] = value
+        w = {name: self._warp(f"line_{name}", value) for name, value in given.items()}
+        w.update({name: self._buffer(f"line_{name}", (nj, ni))[0] for name in ("cp_i", "y", "z", "x_i", "cp_j")})
+        x, x_view = self._buffer("line_x_j", (nj, ni))
         wp.launch(_kc.line_solve_around, dim=nj, device="cpu",
                   inputs=[w["k_m"], w["k_p"], w["rhs"], ni, w["cp_i"], w["y"], w["z"], w["x_i"]])
         wp.launch(_kc.line_solve_rings, dim=ni, device="cpu",
-                  inputs=[w["k_lo"], w["k_hi"], w["diag"], w0, w1, w["x_i"], nj, w["cp_j"], w["x_j"]])
-        return w["x_j"].numpy().copy()
+                  inputs=[w["k_lo"], w["k_hi"], w["diag"], w0, w1, w["x_i"], nj, w["cp_j"], x])
+        return x_view.copy()
 
     def implicit_coefficients(self, c, gam_i, gam_j, Fj_rel):
         """The line solves' coefficients (k_m, k_p, k_lo, k_hi, diag) of c div(Gamma grad q)'s alpha terms and of
