@@ -23,6 +23,17 @@ def test_grid_overrides_replace_only_the_fields_given():
         va.plate_quality("standard", "overset", grid_overrides={"dy_over_dx": 2.0})
 
 
+def test_the_body_fitted_grid_overrides_reach_the_o_grid_and_are_checked():
+    va = load_tool("validate_aero")
+    q = va.plate_quality("standard", "body_fitted",
+                         grid_overrides={"around_per_chord": 240.0, "first_height": 0.00125, "growth": 1.05})
+    g = q.grid
+    assert g.body_fitted and (g.around_per_chord, g.first_height, g.growth) == (240.0, 0.00125, 1.05)
+    assert g.cells_per_chord == preset("standard", "body_fitted").grid.cells_per_chord
+    with pytest.raises(InputError, match="aero.growth"):
+        va.plate_quality("standard", "body_fitted", grid_overrides={"growth": 1.5})
+
+
 def test_a_bad_override_exits_2_naming_the_field_and_writes_nothing(tmp_path, capsys):
     va = load_tool("validate_aero")
     out = tmp_path / "v.json"
