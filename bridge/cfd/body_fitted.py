@@ -505,7 +505,7 @@ class BodyFittedSST:
 
     def _ghosts(self, t: float):
         """The O-grid's ghost rings' k and omega from the background's at their places at t (kept for the next
-        call at the same t until the background's change: a sub-step asks three times)."""
+        call at the same t until the background's change: a sub-step asks twice)."""
         if self._ghost_cache is not None and self._ghost_cache[0] == t:
             return self._ghost_cache[1]
         pair, g = self.pair, self.pair.body.grid
