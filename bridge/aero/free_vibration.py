@@ -87,6 +87,9 @@ class FreeMotion:
     held: tuple[float, float, float]
     release: float
     segments: list = field(default_factory=list)   # up to two (t0, t1, q0, v0, q1, v1), the newest last
+    # counts the pushes: the pose and velocity at a time already asked for can change with a push, and a flow
+    # that keeps them per time (bridge.cfd.curvilinear) keys them on this too
+    revision: int = 0
 
     def _segment(self, t: float):
         if len(self.segments) == 2 and t < self.segments[1][0]:
@@ -109,6 +112,7 @@ class FreeMotion:
 
     def push(self, segment) -> None:
         self.segments = [*self.segments[-1:], segment]
+        self.revision += 1
 
 
 class AeroelasticFlow:

@@ -494,7 +494,7 @@ class BodyFittedSST:
         from .curvilinear_sst import CurvilinearSST
 
         self.pair = pair
-        self._ghost_cache = None   # (t, the ghost rings' k and omega then)
+        self._ghost_cache = None   # (the time's key, the ghost rings' k and omega then)
         og = pair.body.grid
         wall = SimpleNamespace(vertices=np.column_stack([og.x[0], og.y[0]]))
         self.background = KOmegaSST(pair.background, k_inf, omega_inf, "resolved",
@@ -505,15 +505,15 @@ class BodyFittedSST:
 
     def _ghosts(self, t: float):
         """The O-grid's ghost rings' k and omega from the background's at their places at t (kept for the next
-        call at the same t until the background's change: a sub-step asks twice)."""
-        if self._ghost_cache is not None and self._ghost_cache[0] == t:
+        call at the same time (the O-grid's ``_when``) until the background's change: a sub-step asks twice)."""
+        if self._ghost_cache is not None and self._ghost_cache[0] == self.pair.body._when(t):
             return self._ghost_cache[1]
         pair, g = self.pair, self.pair.body.grid
         grid = pair.background.grid
         X, Y = pair.to_background(g.xg, g.yg, t)
         out = tuple(bilinear(s.interior(), grid.x_centres, grid.y_centres, X, Y)
                     for s in (self.background.k, self.background.omega))
-        self._ghost_cache = (t, out)
+        self._ghost_cache = (self.pair.body._when(t), out)
         return out
 
     def hole_cells(self, t: float):

@@ -352,15 +352,20 @@ class CurvilinearFlow(FlowBase):
         self._faces_i, self._faces_j = (P_i, E_i, n0_i, n1_i), (P_j, E_j, n0_j, n1_j)
 
     # --- boundary values --------------------------------------------------------------------------
+    def _when(self, t: float) -> tuple:
+        """The key of what the caches below keep for time t: t and the motion's revision (a motion whose path can
+        change at a time already asked for, bridge.aero.free_vibration.FreeMotion, counts its changes)."""
+        return t, getattr(self.motion, "revision", 0)
+
     def frame_velocity(self, t: float) -> tuple[float, float, float]:
-        """(R^T V_O, Omega): the grid's translation in its own axes and its rotation rate (the last time's
-        kept: a step asks for a few times a dozen times over)."""
-        if self._frame is not None and self._frame[0] == t:
+        """(R^T V_O, Omega): the grid's translation in its own axes and its rotation rate (the last time's kept:
+        a step asks for it about a dozen times)."""
+        if self._frame is not None and self._frame[0] == self._when(t):
             return self._frame[1]
         u, v, om = self.motion.velocity(t)
         ub, vb = _rot(self.motion.pose(t)[2]).T @ np.array([u, v])
         out = (float(ub), float(vb), float(om))
-        self._frame = (t, out)
+        self._frame = (self._when(t), out)
         return out
 
     def _grid_velocity(self, t, px, py):
@@ -373,16 +378,16 @@ class CurvilinearFlow(FlowBase):
 
     def relative_fluxes(self, t: float) -> tuple[np.ndarray, np.ndarray]:
         """The face fluxes now relative to the grid's own motion at t, (nj, ni) through the i-faces and
-        (nj + 1, ni) through the j-faces, the wall face's zero; kept until the fluxes or t change (the arrays are
-        the caller's to read, not to change)."""
+        (nj + 1, ni) through the j-faces, the wall face's zero; kept until the fluxes or the time (``_when``) change
+        (the arrays are the caller's to read, not to change)."""
         c = self._relative
-        if c is not None and c[0] is self.Fi and c[1] is self.Fj and c[2] == t:
+        if c is not None and c[0] is self.Fi and c[1] is self.Fj and c[2] == self._when(t):
             return c[3]
         g = self.grid
         Fi_rel = self.Fi - self._grid_flux(t, g.xmi, g.Si)
         Fj_rel = self.Fj - self._grid_flux(t, g.xmj, g.Sj)
         Fj_rel[0] = 0.0
-        self._relative = (self.Fi, self.Fj, t, (Fi_rel, Fj_rel))
+        self._relative = (self.Fi, self.Fj, self._when(t), (Fi_rel, Fj_rel))
         return Fi_rel, Fj_rel
 
     # --- the explicit terms ---------------------------------------------------------------------
@@ -486,15 +491,15 @@ class CurvilinearFlow(FlowBase):
     def velocity_gradients(self, t: float) -> tuple[tuple[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]:
         """((du/dx, du/dy), (dv/dx, dv/dy)) of the velocity now at the cell centres (:meth:`cell_gradient`: the
         wall faces' the wall's velocity at t, the outer faces' the mean of the outer ring and ghost ring 1).  The
-        stress's transpose part and the turbulence model's strain both need them: kept until the velocity or t
-        changes (the arrays are the caller's to read, not to change)."""
+        stress's transpose part and the turbulence model's strain both need them: kept until the velocity or the
+        time (``_when``) changes (the arrays are the caller's to read, not to change)."""
         c = self._gradients
-        if c is not None and c[0] is self.u and c[1] is self.v and c[2] == t:
+        if c is not None and c[0] is self.u and c[1] is self.v and c[2] == self._when(t):
             return c[3]
         (wfu, wfv), _, (gu, gv) = self._boundary(t)
         out = tuple(self.cell_gradient(q, wf, 0.5 * (q[-1] + gh[0]))
                     for q, wf, gh in ((self.u, wfu, gu), (self.v, wfv, gv)))
-        self._gradients = (self.u, self.v, t, out)
+        self._gradients = (self.u, self.v, self._when(t), out)
         return out
 
     def _transpose_stress(self, t: float):

@@ -149,3 +149,21 @@ def test_forced_runs_about_a_mean_angle():
     assert AeroOptions(mean_angle_deg=1.0).mean_angle_deg == 1.0
     with pytest.raises(InputError, match="aero.mean_angle_deg"):
         AeroOptions(mean_angle_deg=12.0)
+
+
+def test_the_body_fitted_grid_sees_a_push_at_a_time_it_has_already_asked_for():
+    """FreeMotion's path at the current time changes when the structure pushes its next step (the release's
+    kick, and each step's new Hermite segment); the O-grid keeps its frame velocity and relative fluxes per time,
+    so it must see the push (it keys them on the motion's revision)."""
+    from bridge.aero.free_vibration import FreeMotion
+    from bridge.cfd.curvilinear import CurvilinearFlow, CurvilinearGrid, polar_grid
+
+    motion = FreeMotion((0.0, 0.0, 0.0), release=0.01)
+    flow = CurvilinearFlow(CurvilinearGrid(*polar_grid(0.5, 4.0, 16, 0.05, 1.2)), 0.01, motion)
+    flow.set_uniform_flow(1.0, 0.0)
+    flow.step(0.02)
+    t = flow.t
+    assert flow.frame_velocity(t) == (0.0, 0.0, 0.0)
+    kick = np.array([0.0, 0.0, 0.3])
+    motion.push((t, t + 0.02, np.zeros(3), kick, np.zeros(3), kick))
+    assert flow.frame_velocity(t)[2] == pytest.approx(0.3)
