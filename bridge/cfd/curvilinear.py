@@ -290,14 +290,14 @@ class CurvilinearFlow(FlowBase):
                               shape=(m, n))
             B = sp.diags(beta) @ (N[n1] - N[n0])
             return (A + B).tocsr()
-        self._Gi = face_gradient(g.alpha_i.ravel(), g.beta_i.ravel(), P_i, E_i, n0_i, n1_i)
-        self._Gj = face_gradient(g.alpha_j[1:nj].ravel(), g.beta_j[1:nj].ravel(), P_j, E_j, n0_j, n1_j)
+        Gi = face_gradient(g.alpha_i.ravel(), g.beta_i.ravel(), P_i, E_i, n0_i, n1_i)
+        Gj = face_gradient(g.alpha_j[1:nj].ravel(), g.beta_j[1:nj].ravel(), P_j, E_j, n0_j, n1_j)
         # divergence: cells x (i-faces, all j-faces)
         rows = np.r_[P_i, E_i, P_j, E_j]
         cols = np.r_[np.arange(n), np.arange(n), n + ni + np.arange(len(P_j)), n + ni + np.arange(len(P_j))]
         vals = np.r_[np.ones(n), -np.ones(n), np.ones(len(P_j)), -np.ones(len(P_j))]
         self._Dint = sp.csr_matrix((vals, (rows, cols)), shape=(n, n + (nj + 1) * ni))
-        L = (self._Dint[:, :n] @ self._Gi + self._Dint[:, n + ni:n + ni + len(P_j)] @ self._Gj).tolil()
+        L = (self._Dint[:, :n] @ Gi + self._Dint[:, n + ni:n + ni + len(P_j)] @ Gj).tolil()
         # D G phi: the outflow minus inflow of each cell, so L phi = -div(G phi); pinned in cell 0 (pure Neumann)
         L[0, :] = 0.0
         L[0, 0] = 1.0
@@ -331,8 +331,8 @@ class CurvilinearFlow(FlowBase):
             vy += [w_in * sy, w_next * sy]
         inv_a = sp.diags(1.0 / g.area.ravel())
         rows, cols = np.concatenate(rows), np.concatenate(cols)
-        self._Gcx = (inv_a @ sp.csr_matrix((np.concatenate(vx), (rows, cols)), shape=(n, n))).tocsr()
-        self._Gcy = (inv_a @ sp.csr_matrix((np.concatenate(vy), (rows, cols)), shape=(n, n))).tocsr()
+        Gcx = (inv_a @ sp.csr_matrix((np.concatenate(vx), (rows, cols)), shape=(n, n))).tocsr()
+        Gcy = (inv_a @ sp.csr_matrix((np.concatenate(vy), (rows, cols)), shape=(n, n))).tocsr()
         # linear interpolation of centre values to the interior faces (by distance along d)
         def weights(xm, P, E):
             dP = np.hypot(xm[..., 0].ravel() - g.xc.ravel()[P], xm[..., 1].ravel() - g.yc.ravel()[P])
@@ -340,13 +340,11 @@ class CurvilinearFlow(FlowBase):
             w = dP / (dP + dE)
             m = len(P)
             return sp.csr_matrix((np.r_[1 - w, w], (np.r_[np.arange(m), np.arange(m)], np.r_[P, E])), shape=(m, n))
-        self._Ii = weights(g.xmi, P_i, E_i)
-        self._Ij = weights(g.xmj[1:nj], P_j, E_j)
-        # the same stacked, so that a projection makes four sparse products instead of twelve: the interior
+        # each family stacked, so that a projection makes four sparse products instead of twelve: the interior
         # faces' interpolation (i-faces, then j-faces) and every gradient of a cell field (the faces', then the
-        # centres' x and y)
-        self._I_faces = sp.vstack([self._Ii, self._Ij]).tocsr()
-        self._G_all = sp.vstack([self._Gi, self._Gj, self._Gcx, self._Gcy]).tocsr()
+        # centres' x and y: ``_gradient_parts`` splits it)
+        self._I_faces = sp.vstack([weights(g.xmi, P_i, E_i), weights(g.xmj[1:nj], P_j, E_j)]).tocsr()
+        self._G_all = sp.vstack([Gi, Gj, Gcx, Gcy]).tocsr()
         self._Nmat = N
         # the grid's own velocity at the face midpoints is Vb + Omega x xm: its flux through each face
         self._faces_i, self._faces_j = (P_i, E_i, n0_i, n1_i), (P_j, E_j, n0_j, n1_j)
@@ -603,19 +601,19 @@ class CurvilinearFlow(FlowBase):
         """Face fluxes of (us, vs) with the pressure's face gradient put back, the projection, and the
         corrected centres, fluxes and pressure (module doc)."""
         g, nj, ni = self.grid, self.grid.nj, self.grid.ni
-        n, m = nj * ni, (nj - 1) * ni            # cells (and i-faces), interior j-faces
+        n = nj * ni                              # cells, and i-faces
         if accumulate:
-            gp = self._gradients_of_p()
-            uh = us.ravel() + dt * gp[n + m:2 * n + m]
-            vh = vs.ravel() + dt * gp[2 * n + m:]
+            gp_i, gp_j, gpx, gpy = self._gradient_parts(self._gradients_of_p())
+            uh = us.ravel() + dt * gpx.ravel()
+            vh = vs.ravel() + dt * gpy.ravel()
         else:
             uh, vh = us.ravel(), vs.ravel()
         uv = self._I_faces @ np.column_stack([uh, vh])
         Fi = uv[:n, 0] * g.Si[..., 0].ravel() + uv[:n, 1] * g.Si[..., 1].ravel()
         Fj_in = uv[n:, 0] * g.Sj[1:nj, :, 0].ravel() + uv[n:, 1] * g.Sj[1:nj, :, 1].ravel()
         if accumulate:
-            Fi -= dt * gp[:n]
-            Fj_in -= dt * gp[n:n + m]
+            Fi -= dt * gp_i.ravel()
+            Fj_in -= dt * gp_j.ravel()
         Fj = np.empty((nj + 1, ni))
         Fj[0] = self._grid_flux(t_new, g.xmj[0], g.Sj[0])
         Fj[1:nj] = Fj_in.reshape(nj - 1, ni)
@@ -626,12 +624,12 @@ class CurvilinearFlow(FlowBase):
         rhs[0] = 0.0
         # L phi = D G phi (outflow of the gradient's flux) = div / dt
         phi = self._poisson.solve(rhs)
-        gphi = self._G_all @ phi
-        Fi -= dt * gphi[:n].reshape(nj, ni)
-        Fj[1:nj] -= dt * gphi[n:n + m].reshape(nj - 1, ni)
+        gphi_i, gphi_j, gphi_x, gphi_y = self._gradient_parts(self._G_all @ phi)
+        Fi -= dt * gphi_i
+        Fj[1:nj] -= dt * gphi_j
         self.Fi, self.Fj = Fi, Fj
-        self.u = us - dt * gphi[n + m:2 * n + m].reshape(nj, ni)
-        self.v = vs - dt * gphi[2 * n + m:].reshape(nj, ni)
+        self.u = us - dt * gphi_x
+        self.v = vs - dt * gphi_y
         self.p = (self.p + phi.reshape(nj, ni)) if accumulate else np.zeros((nj, ni))
         self.last_divergence = np.abs(np.roll(Fi, -1, axis=1) - Fi + Fj[1:] - Fj[:-1]).max()
 
@@ -695,12 +693,18 @@ class CurvilinearFlow(FlowBase):
             c = self._p_gradients = (self.p, self._G_all @ self.p.ravel())
         return c[1]
 
+    def _gradient_parts(self, stacked: np.ndarray) -> tuple[np.ndarray, ...]:
+        """``_G_all``'s product split (views): the i-faces' (nj, ni), the interior j-faces' (nj - 1, ni), the
+        centres' x and y (nj, ni)."""
+        nj, ni = self.grid.nj, self.grid.ni
+        n, m = nj * ni, (nj - 1) * ni
+        return (stacked[:n].reshape(nj, ni), stacked[n:n + m].reshape(nj - 1, ni),
+                stacked[n + m:2 * n + m].reshape(nj, ni), stacked[2 * n + m:].reshape(nj, ni))
+
     def pressure_gradient(self) -> tuple[np.ndarray, np.ndarray]:
         """grad p at the cell centres (Green-Gauss, the boundary faces' values extrapolated), body axes."""
-        nj, ni = self.p.shape
-        n, m = nj * ni, (nj - 1) * ni
-        gp = self._gradients_of_p()
-        return gp[n + m:2 * n + m].reshape(nj, ni).copy(), gp[2 * n + m:].reshape(nj, ni).copy()
+        _, _, gx, gy = self._gradient_parts(self._gradients_of_p())
+        return gx.copy(), gy.copy()
 
     # --- loads ------------------------------------------------------------------------------------
     def wall_pressure(self) -> np.ndarray:
