@@ -98,7 +98,7 @@ IDENTITY_FIELDS = ("description", "source_path")
 
 # The kernel modules the CFD runs (a test checks that the list is complete): part of the aero stage's key
 # and of each CFD case's checkpoint key (bridge.aero.forced_motion.case_key).
-CFD_KERNELS = ("kernels.cfd", "kernels.transport", "kernels.wall_law")
+CFD_KERNELS = ("kernels.cfd", "kernels.curvilinear", "kernels.transport", "kernels.wall_law")
 
 # Registry; the order here is the run order.
 STAGES: dict[str, Stage] = {
