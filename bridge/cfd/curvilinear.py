@@ -37,9 +37,14 @@ IMPLICIT_ASPECT (along the wall over across it; ``grid.implicit_j``) the advecti
 too, first-order upwind, in the same line solves: at Re 1e8 the flow crossing the wall cells at a sharp corner
 would otherwise set a step a hundred times shorter.  Then the projection, incremental (van
 Kan 1986): the predicted face fluxes (Rhie and Chow's interpolation: the cell pressure gradient taken out, the
-face's put back), D G phi = D F* / c with the nine-point face gradient (a constant matrix, factorised once),
-F = F* - c G phi on the faces, u = u* - c grad phi at the centres (Green-Gauss, the boundary faces' values
-extrapolated along the grid lines), p += phi, c = dt over BDF2's leading coefficient.  The step is set by the
+face's put back, both weighted by c / A_P, A_P the diagonal of the implicit operator the predictor solved:
+SIMPLE's d = V / a_P, OpenFOAM's rAU), D G phi = D F* / c with the nine-point face gradient (a constant matrix,
+factorised once), F = F* - c G phi on the faces, u = u* - c grad phi at the centres (Green-Gauss, the boundary
+faces' values extrapolated along the grid lines), p += phi, c = dt over BDF2's leading coefficient.  Why that
+weight: in the thin wall cells the implicit diffusion makes A_P a hundred or more, so the predictor took out only
+c / A_P times the cell gradient; put back with c, the surplus entered the faces' fluxes, and at a sharp convex
+corner, where the two wall cells' normal gradients meet across one face, it pumped a spurious loop of several U
+through the first rings, growing with the step and setting it (the Great Belt's nose).  The step is set by the
 convective Courant number of the explicit faces (and the explicit cross terms of skewed cells).
 
 The outer boundary's velocity (two rings of ghost cells) and face fluxes come from an ``outer`` provider:
@@ -560,13 +565,6 @@ class CurvilinearFlow(FlowBase):
         f = F * np.where(F > 0, rings[:-1], rings[1:])
         return (f[1:] - f[:-1]) / self.grid.area
 
-    def _implicit_solve(self, rhs, c, Fj_rel):
-        """(I - c L_i)(I - c L_j) x = rhs: the implicit diffusion around the rings, then across them with the
-        implicit j-faces' advection (an approximate factorisation, second order in time as Crank-Nicolson's), one
-        line solve per grid line (kernels/curvilinear.py); x is zero on the wall and the ghost ring (an
-        increment)."""
-        return self.line_solve(rhs, *self.implicit_coefficients(c, self.nu_i, self.nu_j, Fj_rel), self._w0, self._w1)
-
     # --- the step ---------------------------------------------------------------------------------
     def set_uniform_flow(self, u_inf: float = 1.0, v_inf: float = 0.0) -> None:
         """Start from a uniform stream (inertial axes) and project it onto the grid's divergence-free fluxes."""
@@ -597,23 +595,26 @@ class CurvilinearFlow(FlowBase):
             out.append((cross - adv + frame + extra, around + rings, (wf, gh[0])))
         return out
 
-    def _project(self, us, vs, t_new, dt, accumulate=True):
+    def _project(self, us, vs, t_new, dt, accumulate=True, weight=None):
         """Face fluxes of (us, vs) with the pressure's face gradient put back, the projection, and the
-        corrected centres, fluxes and pressure (module doc)."""
+        corrected centres, fluxes and pressure (module doc).  ``weight``: Rhie and Chow's, per cell (default
+        ``dt`` everywhere)."""
         g, nj, ni = self.grid, self.grid.nj, self.grid.ni
         n = nj * ni                              # cells, and i-faces
         if accumulate:
             gp_i, gp_j, gpx, gpy = self._gradient_parts(self._gradients_of_p())
-            uh = us.ravel() + dt * gpx.ravel()
-            vh = vs.ravel() + dt * gpy.ravel()
+            w_cells = dt if weight is None else weight.ravel()
+            w_faces = np.full(self._I_faces.shape[0], dt) if weight is None else self._I_faces @ w_cells
+            uh = us.ravel() + w_cells * gpx.ravel()
+            vh = vs.ravel() + w_cells * gpy.ravel()
         else:
             uh, vh = us.ravel(), vs.ravel()
         uv = self._I_faces @ np.column_stack([uh, vh])
         Fi = uv[:n, 0] * g.Si[..., 0].ravel() + uv[:n, 1] * g.Si[..., 1].ravel()
         Fj_in = uv[n:, 0] * g.Sj[1:nj, :, 0].ravel() + uv[n:, 1] * g.Sj[1:nj, :, 1].ravel()
         if accumulate:
-            Fi -= dt * gp_i.ravel()
-            Fj_in -= dt * gp_j.ravel()
+            Fi -= w_faces[:n] * gp_i.ravel()
+            Fj_in -= w_faces[n:] * gp_j.ravel()
         Fj = np.empty((nj + 1, ni))
         Fj[0] = self._grid_flux(t_new, g.xmj[0], g.Sj[0])
         Fj[1:nj] = Fj_in.reshape(nj - 1, ni)
@@ -670,6 +671,7 @@ class CurvilinearFlow(FlowBase):
         wall_k = self.nu_j[0] * g.alpha_j[0] * (g.wall_w0 + g.wall_w1) / g.area[0]
         top_k = self.nu_j[-1] * g.alpha_j[-1] / g.area[-1]
         new = []
+        coefficients = self.implicit_coefficients(c, self.nu_i, self.nu_j, Fj_rel)
         olds = (None, None) if self._q_old is None else self._q_old
         for q, q_old, e, (_, impl, (wf0, gh0)), gp, wf1, gh1 in (
                 (self.u, olds[0], ex[0], terms[0], gpx, wfu1, gu1[0]),
@@ -679,9 +681,12 @@ class CurvilinearFlow(FlowBase):
             rhs[-1] += c * top_k * (gh1 - gh0)
             if q_old is not None:
                 rhs += (w * w / (1 + w)) / a0 * (q - q_old)
-            new.append(q + self._implicit_solve(rhs, c, Fj_rel))
+            # (I - c L_i)(I - c L_j) x = rhs: the implicit diffusion around the rings, then across them with the
+            # implicit j-faces' advection (an approximate factorisation, second order in time as Crank-Nicolson's)
+            new.append(q + self.line_solve(rhs, *coefficients, self._w0, self._w1))
         self._H, self._dt_old, self._q_old = H, dt, (self.u.copy(), self.v.copy())
-        self._project(new[0], new[1], t_new, c)
+        # Rhie and Chow's weight: the step over the implicit operator's diagonal (module doc)
+        self._project(new[0], new[1], t_new, c, weight=c / (1.0 + sum(coefficients)))
         self.t, self.n_steps, self.last_dt = t_new, self.n_steps + 1, dt
         self.last_force = self._force(t_new)
 
