@@ -3,14 +3,17 @@ thesis asks for the sensitivity of its CFD to the grid).
 
     python tools/sst_grid_study.py --cells 20 40 80 [--angles 0] [--omega 0.5] [--cfl 0.5]
                                    [--quality quick] [--speed 50] [--threads N] [--out out/sst_grid_study.json]
+                                   [--grid body_fitted [--growth G] [--first-height H]]
 
-For each body-grid resolution (cells per chord; the background keeps the preset's coarsening, so it is
-refined with the body grid) the deck is held still at ``--angles`` (degrees, nose-up) for the preset's
-static duration and gives C_D, C_L, C_M (bridge.aero.static, second half of the record); with
-``--omega`` it is also forced in heave and in pitch at that reduced frequency with the thesis's velocity
-amplitudes (tools/reynolds_study.py's runner), giving h_pu, h_mu, h_ptheta, h_mtheta (Eq 4.37). Everything
-else is the preset's, at the deck's Reynolds number V B / nu_air (1.05e8 at 50 m/s). With three resolutions
-in a ratio of two, the observed order p = ln(|f1 - f2| / |f2 - f3|) / ln 2 of each quantity is printed.
+For each body-grid resolution (cells per chord; the background keeps the preset's coarsening, so it is refined
+with the body grid; on ``--grid body_fitted`` the O-grid's nodes around, 2 per cell of a chord, with it, and its
+layers as ``--growth`` and ``--first-height`` say, by default the preset's) the deck is held still at
+``--angles`` (degrees, nose-up) for the preset's static duration and gives C_D, C_L, C_M (bridge.aero.static,
+second half of the record); with ``--omega`` it is also forced in heave and in pitch at that reduced frequency
+with the thesis's velocity amplitudes (tools/reynolds_study.py's runner), giving h_pu, h_mu, h_ptheta, h_mtheta
+(Eq 4.37). Everything else is the preset's, at the deck's Reynolds number V B / nu_air (1.05e8 at 50 m/s). With
+three resolutions in a ratio of two, the observed order p = ln(|f1 - f2| / |f2 - f3|) / ln 2 of each quantity is
+printed.
 Cases keep checkpoints in ``<out>_runs/`` (an interrupted study resumes; a finished case is read back).
 """
 
@@ -43,9 +46,11 @@ def _say(message: str) -> None:
 def run_resolution(cells: int, args, runs: Path) -> dict:
     section = great_belt_section()
     polys = section_polygons(section)
-    q = preset(args.quality, "overset").with_(turbulence="sst", reynolds=args.speed * section.chord_m / NU_AIR,
-                cells_per_chord=cells, cfl=args.cfl)
-    row: dict = {"cells_per_chord": cells, "cfl": args.cfl, "reynolds": q.physics.reynolds, "static": {}}
+    changes = _grid_changes(args)
+    q = preset(args.quality, args.grid).with_(turbulence="sst", reynolds=args.speed * section.chord_m / NU_AIR,
+                                              cells_per_chord=cells, cfl=args.cfl, **changes)
+    row: dict = {"cells_per_chord": cells, "cfl": args.cfl, "reynolds": q.physics.reynolds, "grid": args.grid,
+                 **changes, "static": {}}
     grid_angle = max(abs(a) for a in args.angles)
     for angle in args.angles:
         case = StaticCase(angle, grid_angle)
@@ -58,11 +63,19 @@ def run_resolution(cells: int, args, runs: Path) -> dict:
                                        "steps": rec.steps, "cells": rec.meta["cells"],
                                        "wall_s": time.perf_counter() - t0}
     if args.omega is not None:
-        forced = run_speed(args.speed, args.omega, args.quality, "sst", runs, say=_say, grid="overset",
-                           threads=args.threads, cells_per_chord=cells, cfl=args.cfl)
+        forced = run_speed(args.speed, args.omega, args.quality, "sst", runs, say=_say, grid=args.grid,
+                           threads=args.threads, cells_per_chord=cells, cfl=args.cfl, **changes)
         row.update({name: forced[name] for name in RESPONSES if name in forced})
         row["forced_cases"] = forced["cases"]
     return row
+
+
+def _grid_changes(args) -> dict:
+    """The body-fitted O-grid's layer settings given on the command line (none on the overset pair)."""
+    if args.grid != "body_fitted":
+        return {}
+    given = {"growth": args.growth, "first_height": args.first_height}
+    return {k: v for k, v in given.items() if v is not None}
 
 
 def _order(values: list[float]) -> str:
@@ -104,8 +117,20 @@ def main(argv=None) -> int:
     ap.add_argument("--speed", type=float, default=50.0, help="wind speed [m/s]: the Reynolds number V B / nu")
     ap.add_argument("--threads", type=int, default=None,
                     help="CPU threads of each case (default: 2 on grids of 20 000 cells or more, else 1)")
+    ap.add_argument("--grid", default="overset", choices=["overset", "body_fitted"],
+                    help="the overset pair (default) or the body-fitted O-grid over the background")
+    ap.add_argument("--growth", type=float, default=None,
+                    help="body_fitted: the O-grid's layer growth ratio (1 .. 1.2; default the preset's)")
+    ap.add_argument("--first-height", type=float, default=None,
+                    help="body_fitted: the O-grid's first cell height, chords (default: y+ about 1)")
     ap.add_argument("--out", default="out/sst_grid_study.json")
     args = ap.parse_args(argv)
+    if args.grid != "body_fitted" and (args.growth is not None or args.first_height is not None):
+        ap.error("--growth and --first-height: only with --grid body_fitted")
+    if args.growth is not None and not 1.0 <= args.growth <= 1.2:
+        ap.error(f"--growth: {args.growth} not allowed; allowed: 1 .. 1.2")
+    if args.first_height is not None and not 0.0 < args.first_height <= 0.1:
+        ap.error(f"--first-height: {args.first_height} not allowed; allowed: above 0, at most 0.1 chords")
     if any(not 8 <= c <= 400 for c in args.cells):
         ap.error(f"--cells: {args.cells} not allowed; allowed: 8 .. 400 cells per chord")
     if any(not -10.0 <= a <= 10.0 for a in args.angles):
