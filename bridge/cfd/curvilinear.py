@@ -685,8 +685,12 @@ class CurvilinearFlow(FlowBase):
             # implicit j-faces' advection (an approximate factorisation, second order in time as Crank-Nicolson's)
             new.append(q + self.line_solve(rhs, *coefficients, self._w0, self._w1))
         self._H, self._dt_old, self._q_old = H, dt, (self.u.copy(), self.v.copy())
-        # Rhie and Chow's weight: the step over the implicit operator's diagonal (module doc)
-        self._project(new[0], new[1], t_new, c, weight=c / (1.0 + sum(coefficients)))
+        # Rhie and Chow's weight: the step over the implicit operator's diagonal (module doc); in ring 0 the line
+        # solve weighs the wall's coefficient by wall_w0 (kernels/curvilinear.py)
+        k_m, k_p, k_lo, k_hi, diag = coefficients
+        a_p = 1.0 + k_m + k_p + k_lo + k_hi + diag
+        a_p[0] += k_lo[0] * (g.wall_w0 - 1.0)
+        self._project(new[0], new[1], t_new, c, weight=c / a_p)
         self.t, self.n_steps, self.last_dt = t_new, self.n_steps + 1, dt
         self.last_force = self._force(t_new)
 
