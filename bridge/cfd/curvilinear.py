@@ -542,6 +542,13 @@ class CurvilinearFlow(FlowBase):
                   inputs=[w["k_lo"], w["k_hi"], w["diag"], w0, w1, w["x_i"], nj, w["cp_j"], x])
         return x_view.copy()
 
+    def line_diagonal(self, k_m, k_p, k_lo, k_hi, diag):
+        """The diagonal of the operator ``line_solve`` inverts, unfactorised: 1 plus every coefficient, the wall's in
+        ring 0 times wall_w0 as the line solve weighs it (kernels/curvilinear.py)."""
+        a = 1.0 + k_m + k_p + k_lo + k_hi + diag
+        a[0] += k_lo[0] * (self.grid.wall_w0 - 1.0)
+        return a
+
     def implicit_coefficients(self, c, gam_i, gam_j, Fj_rel):
         """The line solves' coefficients (k_m, k_p, k_lo, k_hi, diag) of c div(Gamma grad q)'s alpha terms and of
         the implicit j-faces' first-order upwind advection by the relative fluxes Fj_rel (the cell's outflow
@@ -603,8 +610,8 @@ class CurvilinearFlow(FlowBase):
         n = nj * ni                              # cells, and i-faces
         if accumulate:
             gp_i, gp_j, gpx, gpy = self._gradient_parts(self._gradients_of_p())
-            w_cells = dt if weight is None else weight.ravel()
-            w_faces = np.full(self._I_faces.shape[0], dt) if weight is None else self._I_faces @ w_cells
+            w_cells = np.full(n, dt) if weight is None else weight.ravel()
+            w_faces = self._I_faces @ w_cells
             uh = us.ravel() + w_cells * gpx.ravel()
             vh = vs.ravel() + w_cells * gpy.ravel()
         else:
@@ -685,12 +692,8 @@ class CurvilinearFlow(FlowBase):
             # implicit j-faces' advection (an approximate factorisation, second order in time as Crank-Nicolson's)
             new.append(q + self.line_solve(rhs, *coefficients, self._w0, self._w1))
         self._H, self._dt_old, self._q_old = H, dt, (self.u.copy(), self.v.copy())
-        # Rhie and Chow's weight: the step over the implicit operator's diagonal (module doc); in ring 0 the line
-        # solve weighs the wall's coefficient by wall_w0 (kernels/curvilinear.py)
-        k_m, k_p, k_lo, k_hi, diag = coefficients
-        a_p = 1.0 + k_m + k_p + k_lo + k_hi + diag
-        a_p[0] += k_lo[0] * (g.wall_w0 - 1.0)
-        self._project(new[0], new[1], t_new, c, weight=c / a_p)
+        # Rhie and Chow's weight: the step over the implicit operator's diagonal (module doc)
+        self._project(new[0], new[1], t_new, c, weight=c / self.line_diagonal(*coefficients))
         self.t, self.n_steps, self.last_dt = t_new, self.n_steps + 1, dt
         self.last_force = self._force(t_new)
 
