@@ -22,6 +22,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from . import __version__
+from .cluster import connect
 from .config import AERODYNAMIC_CHOICES, SCENARIO_DIR, load_scenario, with_aerodynamics
 from .errors import ConvergenceError, InputError
 from .files import atomic_write_text, check_output_root
@@ -130,6 +131,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--workers", type=int, default=None, metavar="N",
                    help="processes running the aero stage's CFD cases side by side (default: 2 on a machine "
                         "with 2 or more cores; 1: one after the other)")
+    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="run the aero stage's CFD cases on the workers of this Dask scheduler (e.g. "
+                        "tcp://host:8786; needs pip install -e \".[dask]\"; docs/guide.md)")
     p.add_argument("--quiet", action="store_true", help="no progress messages")
     p.add_argument("--version", action="version", version=f"bridge-flutter {__version__}")
     return p
@@ -171,6 +175,8 @@ def _run(args: argparse.Namespace, say, written: list[Path]) -> int:
     stages = parse_stages(args.stages)
     if args.workers is not None and not 1 <= args.workers <= 64:
         raise InputError("--workers", args.workers, "allowed: 1 .. 64 processes")
+    if args.scheduler is not None and args.workers is not None:
+        raise InputError("--workers", args.workers, "not with --scheduler, whose workers run the CFD cases")
     if args.quick and args.quality not in (None, "tiny"):
         raise InputError("--quality", args.quality, "not with --quick, which runs every stage coarse (the CFD on "
                          "'tiny'): drop --quick to run this preset with the full FEM")
@@ -184,6 +190,8 @@ def _run(args: argparse.Namespace, say, written: list[Path]) -> int:
                              "command needs its own name (its result folder)")
         seen[sc.name] = arg
         plan_stages(sc, stages)
+    if args.scheduler is not None:
+        connect(args.scheduler).close()   # a scheduler that does not answer is refused before any work
     check_output_root(args.out)
     for sc in scenarios:
         check_target(args.out, sc.name, args.overwrite)
@@ -192,7 +200,8 @@ def _run(args: argparse.Namespace, say, written: list[Path]) -> int:
         raise InputError("--out", str(comparison), "already holds a comparison of an earlier run; pass "
                          "--overwrite to replace it or choose another --out")
     options = RunOptions(quick=args.quick, progress=say, cache=None if args.no_cache else args.out / ".cache",
-                         quality=args.quality, workers=args.workers)
+                         quality=args.quality, workers=args.workers,
+                         scheduler=args.scheduler)
     summaries = {}
     for sc in scenarios:
         t0 = time.perf_counter()

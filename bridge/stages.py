@@ -54,13 +54,15 @@ class RunOptions:
     stage cache (:mod:`bridge.cache`; None: compute every stage afresh and keep nothing);
     ``quality`` the CFD preset of the aero stage (None: the scenario's, "tiny" with ``quick``); ``workers``
     the processes that run the aero stage's CFD cases side by side (None: 2 on a machine with 2 or more
-    cores, :func:`bridge.aero.forced_motion.default_workers`; 1: one after the other, each on all cores)."""
+    cores, :func:`bridge.aero.forced_motion.default_workers`; 1: one after the other, each on all cores);
+    ``scheduler`` the address of a Dask scheduler whose workers run those cases instead (:mod:`bridge.cluster`)."""
 
     quick: bool = False
     progress: Callable[[str], None] | None = None
     cache: Path | None = None
     quality: str | None = None
     workers: int | None = None
+    scheduler: str | None = None
 
     def say(self, message: str) -> None:
         if self.progress is not None:

@@ -301,18 +301,21 @@ def run_sweep(cases: list[Case], sweep_dir: Path, stages: list[str] | None = Non
         say(f"[{len(status)}/{len(cases)}] {name}: {state} ({time.perf_counter() - t0:.0f} s)")
 
     if scheduler:
-        try:
-            from distributed import Client
-        except ImportError:
-            raise InputError("--scheduler", scheduler, 'needs Dask: pip install -e ".[dask]"') from None
-        client = Client(scheduler)
-        futures = client.map(run_case, cases, out_dir=str(cases_dir), stages=stages, quick=quick,
-                             cache_dir=cache, pure=False)
+        from .cluster import connect
+
+        client = connect(scheduler)   # first: an InputError if Dask is not installed
         from distributed import as_completed as dask_completed
 
-        for fut in dask_completed(futures):
-            report(*fut.result())
-        client.close()
+        futures = client.map(run_case, cases, out_dir=str(cases_dir), stages=stages, quick=quick,
+                             cache_dir=cache, pure=False)
+        try:
+            for fut in dask_completed(futures):
+                report(*fut.result())
+        except BaseException:
+            client.cancel(futures)   # the cases not started never start
+            raise
+        finally:
+            client.close()
     elif workers <= 1:
         for c in cases:
             report(*run_case(c, str(cases_dir), stages, quick, cache))
@@ -395,6 +398,10 @@ def main(argv: Sequence[str] | None = None) -> int:
             if args.plot is not None and args.plot.split(".")[0] not in planned | {"scenario"}:
                 raise InputError("--plot", args.plot, f"names no result of the stages this sweep runs "
                                  f"({', '.join(sorted(planned))}); keys look like flutter.critical_speed_m_s")
+            if args.scheduler is not None:
+                from .cluster import connect
+
+                connect(args.scheduler).close()   # a scheduler that does not answer costs nothing
             check_output_root(args.out)
             sweep_dir = args.out / (args.name or f"sweep_{Path(args.scenario).stem}")
             status = run_sweep(cases, sweep_dir, stages, args.quick, args.workers, args.scheduler, say,

@@ -277,6 +277,19 @@ def _case_in_worker(shape, case, quality, checkpoint, checkpoint_every, label) -
         signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
+def _case_on_cluster(shape, case, quality, checkpoint, checkpoint_every, label, progress, stop) -> ForceRecord:
+    """A case on a Dask worker (:func:`bridge.cluster.run_on_cluster`): one thread, ``stop`` checked after
+    every step; without its checkpoint where the worker cannot write the caller's checkpoint folder."""
+    if checkpoint is not None:
+        try:
+            Path(checkpoint).parent.mkdir(parents=True, exist_ok=True)
+        except OSError as err:
+            progress(f"{label}: no checkpoint on this worker ({err.strerror}: {Path(checkpoint).parent})")
+            checkpoint = None
+    return run_case(shape, case, quality, checkpoint, checkpoint_every, threads=1, progress=progress, label=label,
+                    observe=stop)
+
+
 class RunProgress:
     """The progress lines of several cases, each passed on with the whole run's time left appended.
 
@@ -321,20 +334,31 @@ class RunProgress:
 
 
 def run_cases(shape, jobs, quality: Quality, checkpoint_every: int = 2000,
-              progress: Callable[[str], None] | None = None, workers: int | None = None) -> list[ForceRecord]:
+              progress: Callable[[str], None] | None = None, workers: int | None = None,
+              scheduler: str | None = None) -> list[ForceRecord]:
     """:func:`run_case` for every ``(case, checkpoint, label)`` of ``jobs``; the records in the jobs' order.
 
     With ``workers`` > 1 (default :func:`default_workers`) the cases run side by side in that many
     processes, each on one core: on this project's 2-core machine two cases at once finish sooner than the
     same cases one after the other on two threads each (docs/performance.md, "The whole chain").  Their
     progress lines reach ``progress`` from here.  A case that fails stops the others (each keeps its last
-    checkpoint) and its error is raised here; so is Ctrl-C, which the running cases receive too."""
+    checkpoint) and its error is raised here; so is Ctrl-C, which the running cases receive too.
+    ``scheduler``: the address of a Dask scheduler whose workers run the cases instead, each on one thread
+    (:mod:`bridge.cluster`; ``workers`` is then not used)."""
     import multiprocessing
     import queue as queues
     from concurrent.futures import FIRST_EXCEPTION, wait
 
     from bridge.workers import worker_pool
 
+    if scheduler:
+        from bridge.cluster import connect, run_on_cluster, worker_threads
+
+        with connect(scheduler) as client:
+            run = RunProgress(jobs, quality, worker_threads(client), progress)
+            calls = [(shape, case, quality, ckpt, checkpoint_every, label) for case, ckpt, label in jobs]
+            return run_on_cluster(client, _case_on_cluster, calls, progress=run,
+                                  finished=lambda i, _: run.finished(jobs[i][2]))
     workers = default_workers() if workers is None else workers
     run = RunProgress(jobs, quality, workers, progress)
     if workers <= 1 or len(jobs) < 2:

@@ -117,7 +117,8 @@ def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
         jobs.append((case, checkpoint_path(runs, poly, case, q),
                      f"aero static {n + 1}/{len(angles)}, angle {angle:g} deg"))
     # all cases at once, side by side on the cores where that pays (bridge.aero.forced_motion.run_cases)
-    done = run_cases(poly, jobs, q, aopts.checkpoint_every, progress=options.say, workers=options.workers)
+    done = run_cases(poly, jobs, q, aopts.checkpoint_every, progress=options.say, workers=options.workers,
+                     scheduler=options.scheduler)
     for case, rec in zip(cases, done[:len(cases)], strict=True):
         ks = case.reduced_frequencies
         sel = whole_periods(rec, case, q)
