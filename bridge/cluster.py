@@ -1,4 +1,4 @@
-"""Tasks on an existing Dask cluster (``--scheduler ADDRESS``): the aero stage's CFD cases and a sweep's cases.
+"""The aero stage's CFD cases on an existing Dask cluster (``--scheduler ADDRESS``; a sweep uses :func:`connect`).
 
 Dask's ``distributed`` (the optional extra ``pip install -e ".[dask]"``) runs tasks on workers that may sit
 on other machines, so a user with more machines runs the aero stage in the time of its longest case.  What
@@ -6,18 +6,22 @@ local worker processes get from :mod:`bridge.workers` is rebuilt here for a clus
 
 * **progress**: a task puts its lines on a Dask queue that the caller drains twice a second;
 * **stop**: on Ctrl-C, or when a task fails, the caller sets a Dask event and cancels the tasks not started;
-  a running task checks the event between two steps (at most once a second, :class:`StopCheck`) and ends,
-  so no worker of the cluster computes on for nobody;
+  a running CFD case checks the event between two steps (at most once a second, :class:`StopCheck`) and
+  ends, so no worker of the cluster computes on for nobody (a sweep's case, a whole scenario run, has no
+  such check: on Ctrl-C the cases not started are cancelled, the running ones finish);
 * **errors**: a task's exception reaches the caller as the task raised it (:mod:`bridge.errors` pickles).
 
-The workers need this package installed (the same version) and, for the CFD's checkpoints, the caller's
-checkpoint folder at the same path (a shared file system); a worker that cannot write there runs its case
-without checkpoints and says so.  A local Dask cluster for trying it: ``dask scheduler`` in one terminal,
+The workers need this package installed (the same version).  A case writes its checkpoints to the caller's
+checkpoint folder at the same path on its worker, so an interrupted run resumes from them where that path
+is a shared file system; a worker that cannot write there runs its case without checkpoints and says so.
+
+A local Dask cluster for trying it: ``dask scheduler`` in one terminal,
 ``dask worker tcp://127.0.0.1:8786 --nthreads 1 --nworkers 2`` in another.
 """
 
 from __future__ import annotations
 
+import contextlib
 import time
 import uuid
 from collections.abc import Callable, Sequence
@@ -76,7 +80,10 @@ def _task(fn: Callable, args: tuple, queue_name: str, event_name: str):
     stop.next = 0.0   # a task that starts after the stop ends at once
     stop()
     queue = Queue(queue_name)
-    return fn(*args, progress=queue.put, stop=stop)
+    try:
+        return fn(*args, progress=queue.put, stop=stop)
+    finally:
+        queue.close()   # the scheduler drops the queue once no one holds it
 
 
 def worker_threads(client) -> int:
@@ -103,21 +110,27 @@ def run_on_cluster(client, fn: Callable, calls: Sequence[tuple], progress: Calla
                 progress(line)
 
     futures = [client.submit(_task, fn, args, queue_name, event_name, pure=False) for args in calls]
+    results: dict[int, Any] = {}
     try:
-        pending = dict(enumerate(futures))
-        while pending:
+        while len(results) < len(futures):
             time.sleep(0.5)
             drain()
-            for i, f in list(pending.items()):
-                if f.done():
-                    result = f.result()   # a failed call raises its error here (the others are stopped below)
-                    del pending[i]
+            for i, f in enumerate(futures):
+                if i not in results and f.done():
+                    results[i] = f.result()   # a failed call raises its error here (the others are stopped below)
                     if finished is not None:
-                        finished(i, result)
+                        finished(i, results[i])
         drain()
         stop.clear()   # nothing is left to stop: the scheduler forgets the event
-        return [f.result() for f in futures]
+        return [results[i] for i in range(len(futures))]
     except BaseException:
-        stop.set()
-        client.cancel(futures)
+        try:
+            stop.set()
+        finally:
+            client.cancel(futures)
+            with contextlib.suppress(Exception):
+                drain()   # the lines that came before the stop
         raise
+    finally:
+        with contextlib.suppress(Exception):
+            queue.close()

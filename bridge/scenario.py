@@ -184,13 +184,14 @@ def _run(args: argparse.Namespace, say, written: list[Path]) -> int:
     scenarios = [with_aerodynamics(load_scenario(n, main_span_m=args.main_span), args.aerodynamics)
                  for n in args.scenarios]
     seen: dict[str, str] = {}
+    runs_cfd = False
     for arg, sc in zip(args.scenarios, scenarios, strict=True):
         if sc.name in seen:
             raise InputError("name", sc.name, f"given to both {seen[sc.name]} and {arg}: each scenario of one "
                              "command needs its own name (its result folder)")
         seen[sc.name] = arg
-        plan_stages(sc, stages)
-    if args.scheduler is not None:
+        runs_cfd |= "aero" in plan_stages(sc, stages)
+    if args.scheduler is not None and runs_cfd:
         connect(args.scheduler).close()   # a scheduler that does not answer is refused before any work
     check_output_root(args.out)
     for sc in scenarios:

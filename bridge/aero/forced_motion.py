@@ -281,10 +281,16 @@ def _case_on_cluster(shape, case, quality, checkpoint, checkpoint_every, label, 
     """A case on a Dask worker (:func:`bridge.cluster.run_on_cluster`): one thread, ``stop`` checked after
     every step; without its checkpoint where the worker cannot write the caller's checkpoint folder."""
     if checkpoint is not None:
+        import tempfile
+
+        folder = Path(checkpoint).parent
         try:
-            Path(checkpoint).parent.mkdir(parents=True, exist_ok=True)
+            folder.mkdir(parents=True, exist_ok=True)
+            fd, probe = tempfile.mkstemp(dir=folder)   # writable, not merely there
+            os.close(fd)
+            os.unlink(probe)
         except OSError as err:
-            progress(f"{label}: no checkpoint on this worker ({err.strerror}: {Path(checkpoint).parent})")
+            progress(f"{label}: no checkpoint on this worker ({err.strerror or err}: {folder})")
             checkpoint = None
     return run_case(shape, case, quality, checkpoint, checkpoint_every, threads=1, progress=progress, label=label,
                     observe=stop)
