@@ -56,12 +56,12 @@ def connect(address: str):
 
 class StopCheck:
     """Called between two steps of a task on the cluster: raises :class:`CaseStopped` once the caller has set
-    the run's stop event; asks the scheduler at most once every ``every_s`` seconds."""
+    the run's stop event; asks the scheduler at its first call, then at most once every ``every_s`` seconds."""
 
     def __init__(self, event_name: str, every_s: float = 1.0):
         from distributed import Event
 
-        self.event, self.every_s, self.next = Event(event_name), every_s, time.monotonic() + every_s
+        self.event, self.every_s, self.next = Event(event_name), every_s, 0.0
 
     def __call__(self, *_) -> None:
         now = time.monotonic()
@@ -77,8 +77,7 @@ def _task(fn: Callable, args: tuple, queue_name: str, event_name: str):
     from distributed import Queue
 
     stop = StopCheck(event_name)
-    stop.next = 0.0   # a task that starts after the stop ends at once
-    stop()
+    stop()   # a task that starts after the stop ends at once
     queue = Queue(queue_name)
     try:
         return fn(*args, progress=queue.put, stop=stop)
