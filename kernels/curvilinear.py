@@ -10,9 +10,13 @@ diffusion, one thread per grid line, and its explicit stencils (``advection``, `
 ``line_solve_around``: along each ring j, (I - c L_i) x = r with L_i the diffusion around the ring,
   periodic: (L_i x)_i = k_m[i] (x[i-1] - x[i]) + k_p[i] (x[i+1] - x[i]); a cyclic tridiagonal system,
   solved by the Thomas algorithm with the Sherman-Morrison correction.
+``wall_friction``: the friction velocity of each wall face from its first cell on Spalding's law (the SST
+  model's wall function, bridge/cfd/curvilinear_sst.py), one thread per face.
 """
 
 import warp as wp
+
+from kernels.wall_law import friction_uplus
 
 
 @wp.kernel
@@ -257,3 +261,19 @@ def cell_gradient(q: wp.array2d(dtype=wp.float64), wall_face: wp.array(dtype=wp.
         gx[j, i] = (qp * six[j, ip1] - qm * six[j, i] + qhi * sjx[j + 1, i] - qlo * sjx[j, i]) / a
         gy[j, i] = (qp * siy[j, ip1] - qm * siy[j, i] + qhi * sjy[j + 1, i] - qlo * sjy[j, i]) / a
         qm = qp
+
+
+@wp.kernel
+def wall_friction(speed: wp.array(dtype=wp.float64), d: wp.array(dtype=wp.float64), nu: wp.float64,
+                  u_tau: wp.array(dtype=wp.float64)):
+    """u_tau of each wall face from its first cell's speed relative to the wall at the distance d on Spalding's
+    law (kernels/wall_law.py): speed / u+, u+ the root of u+ y+(u+) = speed d / nu; zero where the cell is at
+    rest relative to the wall."""
+    i = wp.tid()
+    s = speed[i]
+    out = wp.float64(0.0)
+    if s > wp.float64(0.0) and d[i] > wp.float64(0.0):
+        up = friction_uplus(s * d[i] / nu)
+        if up > wp.float64(0.0):
+            out = s / up
+    u_tau[i] = out

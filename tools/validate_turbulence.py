@@ -5,6 +5,8 @@
     python tools/validate_turbulence.py plate --nx 200 --t-end 2  # TMR flat plate (about 25 min)
     python tools/validate_turbulence.py ibplate --dy 4e-4 --t-end 2.5  # the same plate immersed, wall function
     python tools/validate_turbulence.py ogplate --t-end 2.5  # the same plate on the body-fitted wall (17 min)
+    python tools/validate_turbulence.py ogplate --walls equilibrium --dy1 4e-4 --growth 1.2 --t-end 2.5
+                                                 # ... with the wall function, the first cell at y+ ~ 40
                                                  [--walls blended|equilibrium|resolved]  # other wall treatments
 
 decay: homogeneous turbulence at rest (no walls: F1 = 0, the outer constants), k0 = 0.01, omega0 = 1,
@@ -35,8 +37,9 @@ ogplate: the same plate on the body-fitted wall (bridge/cfd/curvilinear_sst.py: 
 O-grid): a plate 2 long and ``--thickness`` thick (0.02: 1 % of its length) with semi-elliptic ends (axes 4
 thicknesses by one), the leading edge at x = 0, in a uniform stream (the O-grid's outer boundary ``--outer`` from
 the wall, default 1 as TMR's top boundary; the freestream's k and omega there, which decay on their way to the
-plate), ``--around`` wall nodes, the first cell ``--dy1`` high growing by ``--growth``. Reported as plate's: c_f
-at x = 0.97008 on the upper side against TMR's 0.00271-0.00272.
+plate), ``--around`` wall nodes, the first cell ``--dy1`` high growing by ``--growth``; ``--walls equilibrium``
+takes Spalding's wall function (bridge/cfd/curvilinear_sst.py) for a first cell in the log layer instead of the
+resolved wall (default). Reported as plate's: c_f at x = 0.97008 on the upper side against TMR's 0.00271-0.00272.
 Results are appended to ``--out`` as JSON lines.
 """
 
@@ -285,7 +288,7 @@ def plate_outline(thickness: float, length: float = 2.0, n_end: int = 60) -> np.
 
 
 def ogplate(around=600, dy1=5e-6, growth=1.12, thickness=0.02, outer=1.0, t_end=3.0, reynolds=5e6, cfl=0.8,
-            progress=None):
+            progress=None, walls="resolved"):
     """TMR's flat plate on the body-fitted wall (module doc): returns the flow, its model, x and c_f along the
     upper side, c_f at x = 0.97 every 0.25 L/U and the grid's quality."""
     from bridge.cfd.curvilinear import CurvilinearFlow, CurvilinearGrid, Farfield
@@ -299,7 +302,7 @@ def ogplate(around=600, dy1=5e-6, growth=1.12, thickness=0.02, outer=1.0, t_end=
     flow = CurvilinearFlow(grid, nu, Stationary(), Farfield(1.0, 0.0), cfl=cfl)
     flow.set_uniform_flow(1.0, 0.0)
     k_inf = 9e-9 / 0.2 ** 2                # TMR: k = 9e-9 a^2 at M = 0.2, in units of U^2
-    model = CurvilinearSST(flow, k_inf, k_inf / (0.009 * nu))   # TMR: nu_t / nu = 0.009 in the freestream
+    model = CurvilinearSST(flow, k_inf, k_inf / (0.009 * nu), walls=walls)   # TMR: nu_t / nu = 0.009 outside
     xm, ym = grid.xmj[0, :, 0], grid.xmj[0, :, 1]
     upper = (ym > 0) & (xm > 0.2) & (xm < 1.9)
     order = np.argsort(xm[upper])
@@ -323,7 +326,7 @@ def ogplate(around=600, dy1=5e-6, growth=1.12, thickness=0.02, outer=1.0, t_end=
     return flow, model, x, cf, history, og.quality()
 
 
-def ogplate_report(around, dy1, growth, thickness, outer, t_end, cfl):
+def ogplate_report(around, dy1, growth, thickness, outer, t_end, cfl, walls="resolved"):
     t0 = time.perf_counter()
 
     def progress(t, t_end, cf, n):
@@ -331,7 +334,7 @@ def ogplate_report(around, dy1, growth, thickness, outer, t_end, cfl):
               file=sys.stderr, flush=True)
 
     flow, model, x, cf, history, quality = ogplate(around, dy1, growth, thickness, outer, t_end, cfl=cfl,
-                                                    progress=progress)
+                                                    progress=progress, walls=walls)
     g = flow.grid
     cf97 = float(np.interp(0.97008, x, cf))
     u_tau = np.sqrt(0.5 * cf97)
@@ -340,7 +343,8 @@ def ogplate_report(around, dy1, growth, thickness, outer, t_end, cfl):
     up = flow.u[:, i] / u_tau
     band = (yp >= 30) & (yp <= 300)
     log = np.log(yp) / KAPPA + B
-    return {"case": "SST flat plate (TMR), body-fitted wall", "around": g.ni, "rings": g.nj, "dy1": dy1,
+    return {"case": f"SST flat plate (TMR), body-fitted wall, walls: {walls}", "around": g.ni, "rings": g.nj,
+            "dy1": dy1,
             "growth": growth, "thickness": thickness, "outer": outer, "t_end": t_end, "cfl": cfl,
             "steps": flow.n_steps, "wall_s": time.perf_counter() - t0, "cf_0.97": cf97, "band": [0.00271, 0.00272],
             "first_cell_y+_0.97": float(yp[0]), "cf_0.97_history": history, "grid_quality": quality.summary(),
@@ -381,10 +385,11 @@ def main(argv=None):
     ap.add_argument("--outer", type=float, default=1.0, help="ogplate: the O-grid's reach from the wall")
     ap.add_argument("--cfl", type=float, default=0.8, help="ogplate: the convective Courant number")
     ap.add_argument("--dy", type=float, default=4e-4, help="ibplate: cell height at the plate (4e-4: y+ ~ 100)")
-    ap.add_argument("--walls", choices=KOmegaSST.BODY_WALLS, default="function",
+    ap.add_argument("--walls", choices=KOmegaSST.BODY_WALLS, default=None,
                     help="ibplate: Spalding's wall function everywhere (default), blended with the linear profile "
                          "where the layer is not turbulent, with the log layer's own k production so the layer is "
-                         "turbulent from the front, or no wall law (bridge.cfd.KOmegaSST's body_walls)")
+                         "turbulent from the front, or no wall law (bridge.cfd.KOmegaSST's body_walls); ogplate: "
+                         "resolved (default) or equilibrium")
     ap.add_argument("--nx", type=int, default=200, help="plate: cells along x in [0, 2]")
     ap.add_argument("--dy1", type=float, default=5e-6, help="plate: first cell height (Re 5e6: y+ ~ 1 is 5e-6)")
     ap.add_argument("--growth", type=float, default=1.12, help="plate: cell growth away from the wall")
@@ -404,10 +409,14 @@ def main(argv=None):
     elif args.case == "ibplate":
         if not 5e-5 <= args.dy <= 5e-3:
             ap.error(f"--dy: {args.dy} not allowed; allowed: 5e-5 .. 5e-3")
-        r = ibplate(args.dy, t_end=args.t_end, body_walls=args.walls,
+        r = ibplate(args.dy, t_end=args.t_end, body_walls=args.walls or "function",
                     progress=lambda t, t_end: print(f"  t = {t:.2f} of {t_end:g}", file=sys.stderr, flush=True))
     elif args.case == "ogplate":
-        r = ogplate_report(args.around, args.dy1, args.growth, args.thickness, args.outer, args.t_end, args.cfl)
+        walls = args.walls or "resolved"
+        if walls not in ("resolved", "equilibrium"):
+            ap.error(f"--walls: {walls} not allowed with ogplate; allowed: resolved, equilibrium")
+        r = ogplate_report(args.around, args.dy1, args.growth, args.thickness, args.outer, args.t_end, args.cfl,
+                           walls)
         _plot_plate(r, Path(args.out).with_name(f"ogplate_{args.around}"))
     else:
         r = plate_report(args.nx, args.dy1, args.growth, args.t_end)

@@ -311,8 +311,10 @@ def _overset_flow(q: Quality, polygons: list, case, threads: int | None):
 
 def _body_fitted_flow(q: Quality, polygons: list, case, threads: int | None):
     """The section in a body-fitted O-grid that moves with it over the overset pair's background
-    (bridge.cfd.body_fitted.BodyFittedPair): one outline (appendages are not resolved yet); with SST its wall
-    resolved (bridge.cfd.body_fitted.BodyFittedSST), the first cell at y+ ~ 1 unless the preset says otherwise."""
+    (bridge.cfd.body_fitted.BodyFittedPair): one outline (appendages are not resolved yet); with SST
+    (bridge.cfd.body_fitted.BodyFittedSST) the first cell at y+ ~ 1 unless the preset's ``first_height`` says
+    otherwise, and the wall treatment chosen by that cell's y+: resolved up to y+ 2 (or where ``sst_walls`` is
+    "resolved"), Spalding's wall function above (bridge/cfd/curvilinear_sst.py)."""
     from bridge.cfd import CartesianGrid, freestream_turbulence
     from bridge.cfd.body_fitted import BodyFittedPair, BodyFittedSST
     from bridge.cfd.curvilinear import CurvilinearGrid
@@ -347,5 +349,17 @@ def _body_fitted_flow(q: Quality, polygons: list, case, threads: int | None):
     pair = BodyFittedPair(background, ogrid, _flow_config(q, threads), case.motion())
     pair.set_uniform_flow(1.0)
     if sst:
-        BodyFittedSST(pair, *freestream_turbulence(1.0, 1.0 / q.physics.reynolds))
+        BodyFittedSST(pair, *freestream_turbulence(1.0, 1.0 / q.physics.reynolds), walls=body_fitted_walls(q))
     return pair
+
+
+def body_fitted_walls(q: Quality) -> str:
+    """The body-fitted O-grid's wall treatment with SST, by its first cell's y+: "resolved" where the first cell
+    is at most twice the height of y+ ~ 1 (the default height) or ``sst_walls`` asks for it, else "equilibrium"
+    (Spalding's wall function with the log layer's production of k, bridge/cfd/curvilinear_sst.py)."""
+    from bridge.cfd.curvilinear_sst import first_height_for
+
+    first = q.grid.first_height
+    if q.physics.sst_walls == "resolved" or first == 0.0 or first <= 2.0 * first_height_for(q.physics.reynolds):
+        return "resolved"
+    return "equilibrium"

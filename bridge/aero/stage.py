@@ -28,7 +28,7 @@ from bridge.aero.accuracy import grid_accuracy
 from bridge.aero.forced_motion import ForcedCase, StaticCase, checkpoint_path, run_cases, whole_periods
 from bridge.aero.frequency_response import distortion, forced_motion_response
 from bridge.aero.options import AeroOptions
-from bridge.aero.presets import preset, section_polygons
+from bridge.aero.presets import body_fitted_walls, preset, section_polygons
 from bridge.aero.snapshots import snapshot_files
 from bridge.aero.static import SHEDDING_THRESHOLD, StaticCoefficients, static_coefficients
 from bridge.flutter.aerodynamics import WithLateral
@@ -86,7 +86,9 @@ def scenario_preset(scenario: Any, quality: str | None = None):
         air = scenario.air
         nu_air = air.kinematic_viscosity_m2_s if air is not None else 1.48e-5
         q = q.with_(turbulence=aopts.turbulence, reynolds=aopts.wind_speed_m_s * section.chord_m / nu_air,
-                    sst_walls="resolved" if aopts.grid == "body_fitted" else aopts.sst_walls)   # (its wall: resolved)
+                    sst_walls=aopts.sst_walls)
+        if aopts.grid == "body_fitted":   # its wall treatment follows the first cell's y+ (the report says which)
+            q = q.with_(sst_walls=body_fitted_walls(q))
     return section, q
 
 

@@ -473,7 +473,8 @@ class BodyFittedPair(RigidPair, FlowBase):
 
 class BodyFittedSST:
     """SST-2003 on a :class:`BodyFittedPair`: the background's ``KOmegaSST`` and the O-grid's
-    ``CurvilinearSST`` (its wall resolved), coupled as the velocity is (a turbulence model of bridge/cfd/flow.py:
+    ``CurvilinearSST`` (its wall ``walls``: "resolved", or "equilibrium", Spalding's wall function), coupled as
+    the velocity is (a turbulence model of bridge/cfd/flow.py:
     its O-grid part transported by the pair after each O-grid sub-step, its background part advanced after
     the pair step):
     * background: the cells whose centres lie inside the hole's ring are held at the O-grid's k and omega
@@ -488,7 +489,7 @@ class BodyFittedSST:
 
     name = "sst"
 
-    def __init__(self, pair: BodyFittedPair, k_inf: float, omega_inf: float):
+    def __init__(self, pair: BodyFittedPair, k_inf: float, omega_inf: float, walls: str = "resolved"):
         from types import SimpleNamespace
 
         from .curvilinear_sst import CurvilinearSST
@@ -499,7 +500,7 @@ class BodyFittedSST:
         wall = SimpleNamespace(vertices=np.column_stack([og.x[0], og.y[0]]))
         self.background = KOmegaSST(pair.background, k_inf, omega_inf, "resolved",
                                     far_walls=[(wall, pair.motion.pose(pair.t))], attach=False)
-        self.body = CurvilinearSST(pair.body, k_inf, omega_inf, ghosts=self._ghosts, attach=False)
+        self.body = CurvilinearSST(pair.body, k_inf, omega_inf, ghosts=self._ghosts, attach=False, walls=walls)
         self.k_inf, self.omega_inf = float(k_inf), float(omega_inf)
         pair.use_turbulence(self)
 

@@ -244,8 +244,7 @@ class CurvilinearFlow(FlowBase):
         from ..warp_setup import init_warp
 
         init_warp("cpu")
-        self._w0 = wp.array(grid.wall_w0, dtype=wp.float64, device="cpu")
-        self._w1 = wp.array(grid.wall_w1, dtype=wp.float64, device="cpu")
+        self.use_wall_gradient(grid.wall_w0, grid.wall_w1)
         # the kernels' constant geometry, and their work arrays with their NumPy views (``_buffer``: allocated once;
         # the inputs are copied in through the views, where a new Warp array per input and call cost a tenth of a
         # step)
@@ -433,14 +432,30 @@ class CurvilinearFlow(FlowBase):
                           self._geo["implicit_j"], int(implicit == "upwind"), self._geo["area"], g.ni, out])
         return view.copy()
 
-    def set_eddy_viscosity(self, nu_t: np.ndarray) -> None:
+    def use_wall_gradient(self, w0: np.ndarray, w1: np.ndarray) -> None:
+        """The wall face's normal gradient of the velocity, dq/dn d0 = w0 (q0 - q_w) + w1 (q1 - q_w), in the
+        diffusion, the line solves and the wall's shear: by default the grid's quadratic through the wall and the
+        first two rings; a wall function (bridge/cfd/curvilinear_sst.py) takes the half-cell difference (1, 0)
+        with its own wall diffusivity (:meth:`set_eddy_viscosity`'s ``nu_wall``)."""
+        import warp as wp
+
+        self.wall_w0 = np.ascontiguousarray(np.broadcast_to(np.asarray(w0, dtype=np.float64), (self.grid.ni,)))
+        self.wall_w1 = np.ascontiguousarray(np.broadcast_to(np.asarray(w1, dtype=np.float64), (self.grid.ni,)))
+        self._w0 = wp.array(self.wall_w0, dtype=wp.float64, device="cpu")
+        self._w1 = wp.array(self.wall_w1, dtype=wp.float64, device="cpu")
+
+    def set_eddy_viscosity(self, nu_t: np.ndarray, nu_wall: np.ndarray | None = None) -> None:
         """The eddy viscosity of the cells (nj, ni), from a turbulence model: the momentum's diffusivity becomes
         nu + nu_t on the faces (the mean of the two cells; the wall face nu alone, the outer face's extrapolated
-        from the last two rings), and its stress nu_t (grad u + grad u^T) (the transpose part explicit)."""
+        from the last two rings), and its stress nu_t (grad u + grad u^T) (the transpose part explicit).
+        ``nu_wall`` (ni,): the wall faces' diffusivity instead of nu, a wall function's (its shear over the
+        wall gradient's estimate)."""
         nu_t = np.asarray(nu_t, dtype=np.float64)
         self.nu_t = nu_t
         face_i, face_j = self.eddy_faces(nu_t)
         self.nu_i, self.nu_j = self.nu + face_i, self.nu + face_j
+        if nu_wall is not None:
+            self.nu_j[0] = nu_wall
         self._turbulent = bool(np.any(nu_t != 0.0))
 
     def eddy_faces(self, cell: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -511,6 +526,7 @@ class CurvilinearFlow(FlowBase):
         g = self.grid
         (ux, uy), (vx, vy) = self.velocity_gradients(t)
         nt_i, nt_j = self.nu_i - self.nu, self.nu_j - self.nu
+        nt_j[0] = 0.0   # the wall face: none (a wall function's diffusivity there is the shear's, not nu_t's)
         out = []
         for a, b in ((ux, vx), (uy, vy)):   # row x: (du/dx, dv/dx) . S; row y: (du/dy, dv/dy) . S
             fa = lambda q: 0.5 * (q + np.roll(q, 1, axis=1))  # noqa: E731
@@ -546,7 +562,7 @@ class CurvilinearFlow(FlowBase):
         """The diagonal of the operator ``line_solve`` inverts, unfactorised: 1 plus every coefficient, the wall's in
         ring 0 times wall_w0 as the line solve weighs it (kernels/curvilinear.py)."""
         a = 1.0 + k_m + k_p + k_lo + k_hi + diag
-        a[0] += k_lo[0] * (self.grid.wall_w0 - 1.0)
+        a[0] += k_lo[0] * (self.wall_w0 - 1.0)
         return a
 
     def implicit_coefficients(self, c, gam_i, gam_j, Fj_rel):
@@ -675,7 +691,7 @@ class CurvilinearFlow(FlowBase):
         (wfu1, wfv1), _, (gu1, gv1) = self._boundary(t_new)
         gpx, gpy = self.pressure_gradient()
         Fj_rel = self.relative_fluxes(t)[1]   # the implicit j-faces' advection: by the fluxes now
-        wall_k = self.nu_j[0] * g.alpha_j[0] * (g.wall_w0 + g.wall_w1) / g.area[0]
+        wall_k = self.nu_j[0] * g.alpha_j[0] * (self.wall_w0 + self.wall_w1) / g.area[0]
         top_k = self.nu_j[-1] * g.alpha_j[-1] / g.area[-1]
         new = []
         coefficients = self.implicit_coefficients(c, self.nu_i, self.nu_j, Fj_rel)
@@ -726,16 +742,18 @@ class CurvilinearFlow(FlowBase):
 
     def wall_shear(self, t: float) -> tuple[np.ndarray, np.ndarray]:
         """d(u - u_g)/dn on the wall faces (both components, body axes): the velocity relative to the rigid
-        grid, zero on the wall, one-sided and second order from the first two rings.  Times rho nu it is the
-        wall's traction (the rigid motion's own gradient carries no stress, and div u = 0 leaves only the
-        normal derivative of the relative velocity)."""
+        grid, zero on the wall, from the wall gradient the momentum's diffusion takes (:meth:`use_wall_gradient`:
+        by default one-sided and second order from the first two rings), times the wall faces' diffusivity over
+        nu (1 but under a wall function).  Times rho nu it is the wall's traction (the rigid motion's own
+        gradient carries no stress, and div u = 0 leaves only the normal derivative of the relative velocity)."""
         g = self.grid
-        d0, d1 = g.wall_distance[0], g.wall_distance[1]
+        d0 = g.wall_distance[0]
+        scale = self.nu_j[0] / (self.nu * d0)
         out = []
         for q, k in ((self.u, 0), (self.v, 1)):
             r0 = q[0] - self._grid_velocity(t, g.xc[0], g.yc[0])[k]
             r1 = q[1] - self._grid_velocity(t, g.xc[1], g.yc[1])[k]
-            out.append((d1 ** 2 * r0 - d0 ** 2 * r1) / (d0 * d1 * (d1 - d0)))
+            out.append(scale * (self.wall_w0 * r0 + self.wall_w1 * r1))
         return out[0], out[1]
 
     def _force(self, t: float) -> np.ndarray:

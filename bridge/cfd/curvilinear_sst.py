@@ -11,8 +11,24 @@ omega = 60 nu / (beta_1 d_1^2) on the wall face, d_1 the first cell centre's dis
 Cartesian model takes the first cell's height, a quarter of the value: both are Menter's, and the result does
 not depend on the factor while the first cell lies in the viscous sublayer); the
 wall face's gradient the half-cell difference (omega ~ 1/d^2 next to a wall: a quadratic through the first
-two rings would be worse than none).  Wall functions are not offered: the O-grid is graded from the wall, so
-y+ ~ 1 costs tens of rings even at Re 1e8 (``first_height_for``).
+two rings would be worse than none).
+
+Wall function (``walls="equilibrium"``; the Cartesian model's of the same name, kernels.transport.sst_body_walls):
+for a first cell anywhere from the viscous sublayer to the log layer (y+ up to a few hundred), so that a grid
+need not reach y+ ~ 1, where at Re 1e8 the wall cells are 1e-7 chords thick and, fanned out at a sharp corner,
+set the O-grid's step.  From each first cell's speed U relative to the wall at its distance d (along the wall
+face's normal), Spalding's law gives u_tau (kernels.curvilinear.wall_friction), and
+* momentum: the wall face's shear is u_tau^2 in the direction of U, carried by the half-cell difference with
+  the wall diffusivity nu_w = u_tau^2 d / U (nu in the sublayer, where Spalding's law is u+ = y+), so that the
+  implicit diffusion, the line solves and the wall's force all take it;
+* omega: the first cell held at sqrt(omega_vis^2 + omega_log^2), omega_vis = 6 nu / (beta_1 d^2),
+  omega_log = sqrt(k) / (beta*^(1/4) kappa d) (the sublayer's and the log layer's solutions, blended);
+* k: no flux into the wall, and where the first cell lies in the log layer (y+ > 10.8) the law's own
+  production u_tau^3 / (kappa d) in it (below, the model's own), which does not scale with k: a layer turns
+  turbulent wherever its first cell lies in the log layer, and k settles at u_tau^2 / sqrt(beta*);
+* the first cells' nu_t = k / omega, without the strain limiter (their strain rate spans the wall's jump).
+The same law below y+ ~ 5 is the linear profile: the wall function is the resolved wall on a fine grid, so
+the treatment follows the first cell's y+, face by face, with no switch.
 
 Time step: one step per flow step, after it (segregated: the coefficients and nu_t from the flow's new
 velocity; nu_t handed on is the new k and omega's), in delta form,
@@ -37,6 +53,10 @@ from kernels import transport as _t
 
 from .ogrid import _distance_to_polyline
 from .turbulence import BETA_1
+
+KAPPA = float(_t.KAPPA.value)
+HOLD = float(_t.SST_HOLD.value)              # the rate that holds a cell at a value (source R q, sink R)
+YPLUS_LOG = float(_t.SST_YPLUS_LOG.value)    # y+ where the log law meets u+ = y+
 
 __all__ = ["CurvilinearSST", "first_height_for"]
 
@@ -84,16 +104,24 @@ class CurvilinearSST:
 
     ``k_inf``, ``omega_inf``: the initial state and the freestream's; ``ghosts``: the two ghost rings' k and omega
     at a time, ``ghosts(t) -> ((2, ni), (2, ni))`` (default: the freestream's); ``attach=False`` leaves the
-    stepping to a coupled model (the overset pair's)."""
+    stepping to a coupled model (the overset pair's); ``walls``: "resolved" (the first cell in the viscous
+    sublayer) or "equilibrium" (Spalding's wall function, module doc)."""
 
     name = "sst"
+    WALLS = ("resolved", "equilibrium")
 
-    def __init__(self, flow, k_inf: float, omega_inf: float, ghosts=None, attach: bool = True):
+    def __init__(self, flow, k_inf: float, omega_inf: float, ghosts=None, attach: bool = True,
+                 walls: str = "resolved"):
         if not (k_inf >= 0 and omega_inf > 0):
             raise ValueError(f"k_inf >= 0 and omega_inf > 0 needed, got {k_inf}, {omega_inf}")
+        if walls not in self.WALLS:
+            raise ValueError(f"walls: one of {self.WALLS}, got {walls!r}")
         import warp as wp
 
         self.flow = flow
+        self.walls = walls
+        if walls == "equilibrium":
+            flow.use_wall_gradient(1.0, 0.0)   # the half-cell difference, with the law's wall diffusivity
         g = flow.grid
         self.nu = flow.nu
         self.k_inf, self.omega_inf = float(k_inf), float(omega_inf)
@@ -121,9 +149,53 @@ class CurvilinearSST:
         return self._ghosts(t)
 
     def _walls(self):
-        """((k on the wall faces, at the wall nodes), (omega ...)): node i lies between faces i-1 and i."""
+        """((k on the wall faces, at the wall nodes), (omega ...)): node i lies between faces i-1 and i.  Under the
+        wall function the first cells' own (no gradient into the wall; its faces carry no flux either)."""
+        if self.walls == "equilibrium":
+            return tuple((q[0], 0.5 * (q[0] + np.roll(q[0], 1))) for q in (self.k, self.omega))
         ni, ow = self.flow.grid.ni, self.omega_wall
         return (np.zeros(ni), np.zeros(ni)), (ow, 0.5 * (ow + np.roll(ow, 1)))
+
+    def wall_law(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(u_tau, d, nu_w) of the wall faces under the wall function (module doc): the friction velocity from the
+        first cell's speed relative to the wall on Spalding's law, the cell's distance from its wall face and the
+        wall diffusivity u_tau^2 d / U (nu where the cell is at rest relative to the wall)."""
+        import warp as wp
+
+        from kernels import curvilinear as _kc
+
+        flow, g = self.flow, self.flow.grid
+        ug, vg = flow._grid_velocity(t, g.xc[0], g.yc[0])
+        speed = np.hypot(flow.u[0] - ug, flow.v[0] - vg)
+        d = np.maximum(g.wall_distance[0], 1e-300)
+        out = wp.zeros(g.ni, dtype=wp.float64, device="cpu")
+        wp.launch(_kc.wall_friction, dim=g.ni, device="cpu",
+                  inputs=[wp.array(speed, dtype=wp.float64, device="cpu"), wp.array(d, dtype=wp.float64, device="cpu"),
+                          self.nu, out])
+        u_tau = out.numpy()
+        nu_w = np.where(speed > 0, u_tau * u_tau * d / np.where(speed > 0, speed, 1.0), self.nu)
+        return u_tau, d, np.maximum(nu_w, self.nu)
+
+    def _first_cells(self, t: float, nu_t: np.ndarray, terms=None) -> np.ndarray | None:
+        """Under the wall function, the first cells' nu_t (k / omega, unlimited) put in ``nu_t``, their sources in
+        ``terms`` (k's and omega's (source, sink) pairs: omega held at the blended wall value, k's production the
+        law's where the cell lies in the log layer); returns the wall faces' diffusivity of the momentum; None for a
+        resolved wall."""
+        if self.walls != "equilibrium":
+            return None
+        u_tau, d, nu_w = self.wall_law(t)
+        k0 = np.maximum(self.k[0], 0.0)
+        w_vis = 6.0 * self.nu / (BETA_1 * d * d)
+        w_log = np.sqrt(k0) / (_C["BETA_STAR"] ** 0.25 * KAPPA * d)
+        w_wall = np.sqrt(w_vis * w_vis + w_log * w_log)
+        nu_t[0] = k0 / np.maximum(self.omega[0], 1e-30)
+        if terms is not None:
+            (src_k, _), (src_w, snk_w) = terms
+            log = d * u_tau > YPLUS_LOG * self.nu
+            src_k[0] = np.where(log, u_tau ** 3 / (KAPPA * d), src_k[0])
+            src_w[0] = HOLD * w_wall
+            snk_w[0] = HOLD
+        return nu_w
 
     # --- coefficients ---------------------------------------------------------------------------------
     def update(self, t: float, hand_on: bool = True) -> None:
@@ -135,8 +207,9 @@ class CurvilinearSST:
         wx, wy = flow.cell_gradient(self.omega, ww, 0.5 * (self.omega[-1] + wg[0]))
         self.nu_t, self.f1, self.k_terms, self.w_terms = sst_terms(self.k, self.omega, self._strain(t),
                                                                    kx * wx + ky * wy, self.wall_distance, self.nu)
+        nu_w = self._first_cells(t, self.nu_t, (self.k_terms, self.w_terms))
         if hand_on:
-            flow.set_eddy_viscosity(self.nu_t)
+            flow.set_eddy_viscosity(self.nu_t, nu_w)
 
     def _strain(self, t: float) -> np.ndarray:
         """S^2 = 2 S_ij S_ij of the flow's velocity now."""
@@ -148,7 +221,7 @@ class CurvilinearSST:
         not depend on the cross diffusion, so grad k . grad omega is left out); the rest waits for the next
         transport, which starts with :meth:`update`."""
         self.nu_t = sst_terms(self.k, self.omega, self._strain(t), 0.0, self.wall_distance, self.nu)[0]
-        self.flow.set_eddy_viscosity(self.nu_t)
+        self.flow.set_eddy_viscosity(self.nu_t, self._first_cells(t, self.nu_t))
 
     def _face_diffusivity(self, sigma_1: float, sigma_2: float):
         """nu + sigma nu_t on the i- and j-faces: the flow's rule for nu_t (``eddy_faces``) but on the outer
@@ -156,7 +229,10 @@ class CurvilinearSST:
         sigma = self.f1 * sigma_1 + (1 - self.f1) * sigma_2
         gi, gj = self.flow.eddy_faces(sigma * self.nu_t)
         gj[-1] = (sigma * self.nu_t)[-1]   # the outer face: the outer ring's (no extrapolation)
-        return self.nu + gi, self.nu + gj
+        gj = self.nu + gj
+        if self.walls == "equilibrium":
+            gj[0] = 0.0   # no flux of k or omega into the wall
+        return self.nu + gi, gj
 
     # --- the step -------------------------------------------------------------------------------------
     def residual(self, q, terms, sigmas, wall, ghosts, Fi_rel, Fj_rel):

@@ -12,7 +12,7 @@ import pytest
 
 from bridge.aero.forced_motion import ForcedCase
 from bridge.aero.options import AeroOptions
-from bridge.aero.presets import build_flow, preset, section_polygons
+from bridge.aero.presets import body_fitted_walls, build_flow, preset, section_polygons
 from bridge.aero.stage import scenario_preset
 from bridge.cfd import BoundaryConditions, CartesianGrid, Flow, FlowConfig, PrescribedMotion, Stationary, run
 from bridge.cfd.body_fitted import BodyFittedPair, BodyFittedSST, node_stream_function
@@ -143,3 +143,19 @@ def test_sst_on_the_body_fitted_pair_resolves_the_wall():
     assert first == pytest.approx(first_height_for(1e6), rel=0.05)
     run(flow, 0.2)
     assert flow.turbulence.body.nu_t.max() > 0 and np.isfinite(flow.total_force).all()
+    assert flow.turbulence.body.walls == "resolved"
+
+
+def test_a_first_cell_in_the_log_layer_takes_the_wall_function():
+    """The O-grid's wall treatment follows its first cell's y+: at 40 times the y+ ~ 1 height, Spalding's wall
+    function; ``sst_walls = "resolved"`` keeps the resolved wall whatever the height."""
+    q = preset("tiny", "body_fitted").with_(turbulence="sst", reynolds=1e6, first_height=40 * first_height_for(1e6))
+    assert body_fitted_walls(q) == "equilibrium" and body_fitted_walls(q.with_(sst_walls="resolved")) == "resolved"
+    assert body_fitted_walls(q.with_(first_height=1.5 * first_height_for(1e6))) == "resolved"
+    flow = build_flow(q, section_polygons(FlatPlate(1.0, 0.04))[:1], ForcedCase.thesis("heave", 1.0))
+    body = flow.turbulence.body
+    assert body.walls == "equilibrium" and np.all(flow.body.wall_w0 == 1.0) and np.all(flow.body.wall_w1 == 0.0)
+    run(flow, 0.2)
+    u_tau, d, nu_w = body.wall_law(flow.body.t)
+    assert np.isfinite(flow.total_force).all() and np.median(d * u_tau / 1e-6) > 5
+    assert np.array_equal(flow.body.nu_j[0], nu_w) and np.median(nu_w) > 2e-6   # the law's wall diffusivity

@@ -81,3 +81,53 @@ def test_a_resumed_run_continues_bit_for_bit():
     b.restore_arrays(saved, t, n)
     run(b, 0.6)
     assert np.array_equal(a.u, b.u) and np.array_equal(a.turbulence.omega, b.turbulence.omega)
+
+
+def _spalding_yplus(up):
+    """Spalding's law (Spalding 1961, J. Appl. Mech. 28: 455), kappa 0.41, B 5.0: y+ from u+ in closed form."""
+    z = 0.41 * up
+    return up + math.exp(-0.41 * 5.0) * (math.exp(z) - 1 - z - z * z / 2 - z ** 3 / 6)
+
+
+def _wall_function_flow(speed: float, nu: float = 1e-6):
+    """A cylinder's O-grid in a uniform stream ``speed`` (no step taken), with the SST wall function."""
+    x, y = polar_grid(0.5, 5.0, 64, 2e-3, 1.15)
+    flow = CurvilinearFlow(CurvilinearGrid(x, y), nu, Stationary(), Farfield(speed, 0.0))
+    flow.set_uniform_flow(speed)
+    return flow, CurvilinearSST(flow, 1e-6 * speed ** 2, 1.0, walls="equilibrium")
+
+
+def test_the_wall_function_gives_spaldings_friction_and_takes_it_into_the_flows_shear():
+    flow, m = _wall_function_flow(1.0)
+    u_tau, d, nu_w = m.wall_law(0.0)
+    g = flow.grid
+    speed = np.hypot(flow.u[0], flow.v[0])
+    for i in (10, 16, 40):   # the sides: the first cell's point on the law, U / u_tau = u+ at y+ = d u_tau / nu
+        up, yp = speed[i] / u_tau[i], d[i] * u_tau[i] / flow.nu
+        assert yp > 30 and _spalding_yplus(up) == pytest.approx(yp, rel=1e-9)
+    # the flow's wall shear (its force's) is u_tau^2 along the first cell's relative velocity
+    su, sv = flow.wall_shear(0.0)
+    assert np.allclose(flow.nu * np.hypot(su, sv), u_tau ** 2, rtol=1e-9)
+    assert np.allclose(nu_w, u_tau ** 2 * d / speed) and np.all(flow.nu_j[0] == nu_w)
+    # in the viscous sublayer the law is u+ = y+: the wall diffusivity is nu and the shear the linear profile's
+    slow, _ = _wall_function_flow(1e-6)
+    assert np.allclose(slow.nu_j[0], slow.nu, rtol=1e-6)
+    su, _ = slow.wall_shear(0.0)
+    assert np.allclose(su, (slow.u[0]) / g.wall_distance[0], rtol=1e-6)
+
+
+def test_the_wall_function_holds_the_first_cells_omega_and_keeps_k_and_omega_from_the_wall():
+    flow, m = _wall_function_flow(1.0)
+    run(flow, 0.05)
+    k0 = m.k[0].copy()
+    flow.step()
+    d = flow.grid.wall_distance[0]
+    w_vis, w_log = 6 * flow.nu / (0.075 * d ** 2), np.sqrt(k0) / (0.09 ** 0.25 * 0.41 * d)
+    # omega held at the blend of the sublayer's and the log layer's, by the k the step started from
+    assert np.allclose(m.omega[0], np.hypot(w_vis, w_log), rtol=1e-9)
+    assert np.all(m.nu_t[0] > 0) and np.allclose(m.nu_t[0], m.k[0] / m.omega[0])
+    # the log layer's production made k grow from the freestream's 1e-6 in the first ring, and no k left
+    # through the wall (no flux: k is largest at the wall, not zero there as on a resolved wall)
+    assert np.all(m.k[0] > 1e-4) and np.median(m.k[0] / m.k[3]) > 1
+    with pytest.raises(ValueError, match="walls"):
+        CurvilinearSST(flow, 1e-6, 1.0, walls="function")
