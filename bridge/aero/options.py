@@ -21,10 +21,10 @@ Keys (all optional):
                           moves); "single": one grid, the section an immersed body moving on it (with "sst"
                           its forces jitter as the faces change class: docs/cfd.md, "Immersed boundary");
                           "body_fitted": an O-grid graded from the section's wall over the same background
-                          (bridge/cfd/body_fitted.py; one outline only so far; with "sst" the first cell
-                          at the preset's height, y+ ~ 1 by default, and the wall resolved up to y+ 2,
-                          Spalding's wall function above, unless sst_walls is "resolved": docs/cfd.md,
-                          "Body-fitted grid")
+                          (bridge/cfd/body_fitted.py; one outline only so far; with "sst" the wall
+                          resolved, the presets' first cell at y+ ~ 1, whatever sst_walls says; a tool's
+                          larger first cell takes Spalding's wall function: docs/cfd.md, "Body-fitted
+                          grid")
     turbulence            "sst" (default): the k-omega SST model (2003 variant) with Spalding's wall function on
                           the section, at the deck's Reynolds number Re = wind_speed_m_s B / nu_air ([air]
                           kinematic viscosity), on either grid (bridge/cfd/turbulence.py, docs/cfd.md);

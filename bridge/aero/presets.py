@@ -313,8 +313,8 @@ def _body_fitted_flow(q: Quality, polygons: list, case, threads: int | None):
     """The section in a body-fitted O-grid that moves with it over the overset pair's background
     (bridge.cfd.body_fitted.BodyFittedPair): one outline (appendages are not resolved yet); with SST
     (bridge.cfd.body_fitted.BodyFittedSST) the first cell at y+ ~ 1 unless the preset's ``first_height`` says
-    otherwise, and the wall treatment chosen by that cell's y+: resolved up to y+ 2 (or where ``sst_walls`` is
-    "resolved"), Spalding's wall function above (bridge/cfd/curvilinear_sst.py)."""
+    otherwise, and the wall treatment chosen by that height (:func:`body_fitted_walls`): resolved up to twice
+    the y+ ~ 1 height, Spalding's wall function above (bridge/cfd/curvilinear_sst.py)."""
     from bridge.cfd import CartesianGrid, freestream_turbulence
     from bridge.cfd.body_fitted import BodyFittedPair, BodyFittedSST
     from bridge.cfd.curvilinear import CurvilinearGrid
@@ -354,9 +354,10 @@ def _body_fitted_flow(q: Quality, polygons: list, case, threads: int | None):
 
 
 def body_fitted_walls(q: Quality) -> str:
-    """The body-fitted O-grid's wall treatment with SST, by its first cell's y+: "resolved" where the first cell
-    is at most twice the height of y+ ~ 1 (the default height) or ``sst_walls`` asks for it, else "equilibrium"
-    (Spalding's wall function with the log layer's production of k, bridge/cfd/curvilinear_sst.py)."""
+    """The body-fitted O-grid's wall treatment with SST, by its first cell's height: "resolved" where it is at
+    most twice the height that puts y+ ~ 1 at the cell's top (``first_height_for``; the default height) or
+    ``sst_walls`` is "resolved", else "equilibrium" (Spalding's wall function with the log layer's production of
+    k, bridge/cfd/curvilinear_sst.py; checked for first-cell centres at y+ 18-75, docs/validation.md row 17c)."""
     from bridge.cfd.curvilinear_sst import first_height_for
 
     first = q.grid.first_height
