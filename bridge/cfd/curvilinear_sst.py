@@ -57,13 +57,12 @@ from .ogrid import _distance_to_polyline
 from .turbulence import BETA_1
 
 KAPPA = float(_t.KAPPA.value)
-HOLD = float(_t.SST_HOLD.value)              # the rate that holds a cell at a value (source R q, sink R)
-YPLUS_LOG = float(_t.SST_YPLUS_LOG.value)    # y+ where the log law meets u+ = y+
 
 __all__ = ["CurvilinearSST", "first_height_for"]
 
 _C = {name: float(getattr(_t, f"SST_{name}").value) for name in
-      ("BETA_STAR", "A1", "SIGMA_K1", "SIGMA_K2", "SIGMA_W1", "SIGMA_W2", "BETA1", "BETA2", "GAMMA1", "GAMMA2")}
+      ("BETA_STAR", "A1", "SIGMA_K1", "SIGMA_K2", "SIGMA_W1", "SIGMA_W2", "BETA1", "BETA2", "GAMMA1", "GAMMA2",
+       "HOLD", "YPLUS_LOG")}   # HOLD: the rate that holds a cell at a value; YPLUS_LOG: where u+ = y+ meets the log law
 
 
 def first_height_for(reynolds: float, y_plus: float = 1.0, chord: float = 1.0) -> float:
@@ -193,16 +192,15 @@ class CurvilinearSST:
             return None
         u_tau, d, nu_w = self.wall_law(t)
         k0 = np.maximum(self.k[0], 0.0)
-        w_vis = 6.0 * self.nu / (BETA_1 * d * d)
-        w_log = np.sqrt(k0) / (_C["BETA_STAR"] ** 0.25 * KAPPA * d)
-        w_wall = np.sqrt(w_vis * w_vis + w_log * w_log)
         nu_t[0] = k0 / np.maximum(self.omega[0], 1e-30)
         if terms is not None:
+            w_vis = 6.0 * self.nu / (BETA_1 * d * d)
+            w_log = np.sqrt(k0) / (_C["BETA_STAR"] ** 0.25 * KAPPA * d)
             (src_k, _), (src_w, snk_w) = terms
-            log = d * u_tau > YPLUS_LOG * self.nu
+            log = d * u_tau > _C["YPLUS_LOG"] * self.nu
             src_k[0] = np.where(log, u_tau ** 3 / (KAPPA * d), src_k[0])
-            src_w[0] = HOLD * w_wall
-            snk_w[0] = HOLD
+            src_w[0] = _C["HOLD"] * np.sqrt(w_vis * w_vis + w_log * w_log)
+            snk_w[0] = _C["HOLD"]
         return nu_w
 
     # --- coefficients ---------------------------------------------------------------------------------
