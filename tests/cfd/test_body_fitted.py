@@ -159,3 +159,28 @@ def test_a_first_cell_in_the_log_layer_takes_the_wall_function():
     u_tau, d, nu_w = body.wall_law(flow.body.t)
     assert np.isfinite(flow.total_force).all() and np.median(d * u_tau / 1e-6) > 5
     assert np.array_equal(flow.body.nu_j[0], nu_w) and np.median(nu_w) > 2e-6   # the law's wall diffusivity
+
+
+def test_the_hole_keeps_two_background_cells_from_the_wall_and_half_the_rings_of_overlap():
+    """bridge.cfd.body_fitted.hole_ring: half the O-grid's rings of overlap (at least 4 background cells) where
+    that leaves the hole two background cells out; on a ring stack graded from 3e-5 (a wall function's first cell
+    on the Great Belt deck) half the rings lie within 0.02 of the wall, so the hole moves out to the first ring
+    two cells away, still four inside the outer ring; an O-grid too thin for the overlap is refused."""
+    from bridge.cfd.body_fitted import hole_ring
+
+    def distances(og, j):
+        return (np.hypot(og.x[j] - og.x[0], og.y[j] - og.y[0]).min(),
+                np.hypot(og.x[j] - og.x[-1], og.y[j] - og.y[-1]).min())
+
+    mild = CurvilinearGrid(*polar_grid(0.05, 0.12, 64, 0.002, 1.1))   # DFG 2D-1's first O-grid, background D/32
+    j = hole_ring(mild, 0.1 / 32)
+    assert j == mild.nj - mild.nj // 2 and distances(mild, j)[0] > 2 * 0.1 / 32
+    graded = CurvilinearGrid(*polar_grid(0.5, 1.5, 64, 3e-5, 1.1))
+    h = 0.125
+    j = hole_ring(graded, h)
+    half = hole_ring(graded, h, wall_cells=0.0)
+    assert half == graded.nj - graded.nj // 2 and distances(graded, half)[0] < 0.02
+    wall, outer = distances(graded, j)
+    assert wall >= 2 * h > distances(graded, j - 1)[0] and outer >= 4 * h
+    with pytest.raises(ValueError, match="no hole left"):
+        hole_ring(graded, 0.3)
