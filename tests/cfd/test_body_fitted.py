@@ -98,7 +98,7 @@ def test_a_settled_flow_does_not_depend_on_the_time_step():
     assert abs(cds[0] / cds[1] - 1) < 3e-5 and abs(cds[1] / cds[2] - 1) < 3e-5, cds
 
 
-@pytest.mark.parametrize("turbulence", ["laminar", "sst"])
+@pytest.mark.parametrize("turbulence", ["laminar", pytest.param("sst", marks=pytest.mark.slow)])   # sst: 5 s
 def test_a_body_fitted_case_resumes_bit_for_bit(turbulence):
     q = preset("tiny", "body_fitted")
     if turbulence == "sst":

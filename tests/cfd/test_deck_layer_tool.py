@@ -151,6 +151,7 @@ def test_a_short_run_reads_the_layer_over_the_top(tmp_path):
     assert got["C_N_pressure"] * got["C_L"] > 0        # the lift's sign from the pressure samples
 
 
+@pytest.mark.slow   # 5 s; the default run keeps the tool's short run
 def test_the_plate_held_at_plus_and_minus_an_angle_reads_the_same_layer_on_opposite_sides(tmp_path):
     """The bottom is read as the top of the mirrored section: a symmetric plate at +2 degrees shows under its
     bottom what it shows over its top at -2 (to round-off), with the lift and moment reversed."""

@@ -39,6 +39,7 @@ def test_wake_harmonic_recovers_a_travelling_wave():
     np.testing.assert_allclose(speed, c0, rtol=1e-3)   # the phase slope by central differences
 
 
+@pytest.mark.slow   # 4 s: the tool end to end; its model is tested in the default run
 def test_plate_wake_tool_runs_tiny(tmp_path, capsys):
     """End to end on the tiny preset, where the 2 % plate is under a cell thick: it says so and still writes
     its JSON and plot."""
