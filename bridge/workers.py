@@ -125,6 +125,11 @@ def worker_pool(workers: int, context=None, initializer: Callable | None = None,
         if stopping is not None:
             stopping.set()
         children = multiprocessing.active_children()   # the pool's workers (its manager is a thread)
+        # shutdown(wait=False) forgets the pool's manager thread, so the shutdown(wait=True) below would not
+        # wait for it: held here, it is joined, else its end (which frees the pool's queues and unlinks their
+        # semaphores) could be cut off by the program's exit half-way, and the resource tracker would warn
+        # of "leaked" semaphores after the program's last line
+        manager = getattr(pool, "_executor_manager_thread", None)
         try:
             pool.shutdown(wait=False, cancel_futures=True)
             stop_processes(children, grace_s)
@@ -135,5 +140,7 @@ def worker_pool(workers: int, context=None, initializer: Callable | None = None,
                         p.kill()
             with contextlib.suppress(BaseException):
                 pool.shutdown(wait=True)
+                if manager is not None:
+                    manager.join(grace_s)
         raise
     pool.shutdown(wait=True)
