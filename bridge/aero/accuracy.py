@@ -20,6 +20,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from bridge.aero.presets import QUALITY
+
 __all__ = ["GridRecord", "GRID_STUDY", "grid_accuracy", "covered_by_study"]
 
 
@@ -66,13 +68,18 @@ def grid_accuracy(section, aero_options, quality: str, reynolds: float) -> tuple
     high) in per cent by which the V_c lies below the grid-converged estimate (None where no study covers
     the run: the sentence then says so)."""
     record = GRID_STUDY.get(quality)
-    if record is not None and covered_by_study(section, aero_options, reynolds):
+    cells = aero_options.cells_per_chord
+    own_grid = cells in (0, QUALITY[quality].grid.cells_per_chord) if quality in QUALITY else not cells
+    if record is not None and own_grid and covered_by_study(section, aero_options, reynolds):
         lo, hi = record.vc_low_percent
         return (f"grid study of this deck and flow model: on '{quality}' V_c lies {lo:g}-{hi:g} % below the "
                 f"grid-converged estimate and {record.derivatives} ({record.basis}; docs/aero.md)"), (lo, hi)
     if record is None:
         return (f"no grid study covers the '{quality}' preset: its grid error is unknown; a smoke run, not to be "
                 "used"), None
+    if not own_grid:
+        return (f"no grid study covers '{quality}' on {cells} cells per chord (aero.cells_per_chord): its grid "
+                "error is unknown; compare it with the preset's own grid"), None
     lo, hi = record.vc_low_percent
     return (f"no grid study covers this deck and flow model: the grid error of its V_c on '{quality}' is unknown "
             f"(on the Great Belt deck with k-omega SST the same preset's V_c lies {lo:g}-{hi:g} % low; "

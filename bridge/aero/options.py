@@ -4,6 +4,10 @@ Keys (all optional):
     quality               "tiny" | "quick" | "standard" | "fine": grid, time step, Reynolds number and
                           periods of bridge.aero.forced_motion.QUALITY (default "quick"; --quality on the
                           command line wins; --quick means "tiny")
+    cells_per_chord       the body grid's cells per chord instead of the preset's (8-2000; default 0: the
+                          preset's): the same preset on another grid, to see how far a result moves with the
+                          grid (the background and, on "body_fitted", the O-grid's nodes around follow it); no
+                          grid study covers a changed grid, and the headline says so
     reduced_velocities    U/(fB) of the forced-motion runs (default 4, 6, 8, 10, 12, 16; at least 2):
                           the flutter search may use reduced frequencies K = 2 pi / (U/(fB)) only inside
     heave_rate            heave velocity amplitude over the wind speed, udot_0 / V (default the thesis's
@@ -78,6 +82,8 @@ class AeroOptions:
     wind_speed_m_s: float = 50.0
     sst_walls: str = "equilibrium"
     mean_angle_deg: float = 0.0
+    cells_per_chord: int = 0
+
 
     def __post_init__(self):
         check_flow_model(self.turbulence, self.sst_walls, USER_SST_WALLS)
@@ -86,6 +92,9 @@ class AeroOptions:
         if self.grid not in GRIDS:
             raise InputError("aero.grid", self.grid, f"one of {', '.join(GRIDS)}")
 
+        cells = self.cells_per_chord
+        if isinstance(cells, bool) or not isinstance(cells, int) or (cells != 0 and not 8 <= cells <= 2000):
+            raise InputError("aero.cells_per_chord", cells, "an integer from 8 to 2000, or 0 (the preset's)")
         if self.quality not in QUALITY:
             raise InputError("aero.quality", self.quality, f"one of {', '.join(QUALITY)}")
         values = self.reduced_velocities

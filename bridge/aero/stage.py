@@ -82,6 +82,8 @@ def scenario_preset(scenario: Any, quality: str | None = None):
     section = scenario.deck_section or great_belt_section()
     aopts: AeroOptions = scenario.aero or AeroOptions()
     q = preset(quality or aopts.quality, aopts.grid)
+    if aopts.cells_per_chord:   # the preset on another grid (a grid study of the user's)
+        q = q.with_(cells_per_chord=aopts.cells_per_chord)
     if aopts.turbulence != "laminar":   # the deck's own Reynolds number, with the SST model
         air = scenario.air
         nu_air = air.kinematic_viscosity_m2_s if air is not None else 1.48e-5
@@ -103,7 +105,8 @@ def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
     Ks = np.array(sorted(2 * np.pi / np.asarray(aopts.reduced_velocities)))
     runs = options.cache / "aero-runs" if options.cache is not None else None
     options.say(f"aero: {section.describe()}; {len(Ks)} reduced frequencies x heave and pitch on the "
-                f"{quality!r} preset ({aopts.grid} grid, Re = {q.physics.reynolds:.3g}, {_flow_model(q)})")
+                f"{quality!r} preset ({aopts.grid} grid, {q.grid.cells_per_chord} cells per chord, "
+                f"Re = {q.physics.reynolds:.3g}, {_flow_model(q)})")
     values = {n: np.zeros(len(Ks), dtype=complex) for n in VERTICAL_TORSIONAL + ("h_qu", "h_qtheta")}
     errors = {n: np.zeros(len(Ks), dtype=complex) for n in values}
     records, cells, grids = [], 0, ""

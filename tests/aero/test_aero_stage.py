@@ -146,6 +146,35 @@ def test_the_grid_option_is_checked_and_picks_the_overset_pair():
         preset("quick", "chimera")
 
 
+def test_cells_per_chord_puts_the_preset_on_another_grid_and_the_headline_loses_its_grid_record():
+    """[aero] cells_per_chord: the same preset on a grid of the user's (a grid study), in the stage's key; the
+    grid study's record of the preset does not apply to it, so the headline gives no corrected range."""
+    from dataclasses import replace as dc_replace
+
+    from bridge.aero.accuracy import grid_accuracy
+    from bridge.aero.options import AeroOptions
+    from bridge.aero.stage import scenario_preset
+    from bridge.cache import stage_key
+    from bridge.config import load_scenario
+    from bridge.errors import InputError
+
+    for bad in (4, 2001, 16.5, True, "24"):
+        with pytest.raises(InputError, match="aero.cells_per_chord"):
+            AeroOptions(cells_per_chord=bad)
+    sc = load_scenario("great_belt")
+    for grid in ("overset", "body_fitted"):
+        finer = dc_replace(sc, aero=AeroOptions(grid=grid, cells_per_chord=24))
+        section, q = scenario_preset(finer)
+        assert q.name == "quick" and q.grid.cells_per_chord == 24
+        assert scenario_preset(dc_replace(sc, aero=AeroOptions(grid=grid)))[1].grid.cells_per_chord == 16
+    keys = {stage_key("aero", dc_replace(sc, aero=AeroOptions(cells_per_chord=c)), {}, False) for c in (0, 16, 24)}
+    assert len(keys) == 3
+    for own in (0, 16):   # the preset's own grid
+        assert grid_accuracy(section, AeroOptions(cells_per_chord=own), "quick", 1.05e8)[1] is not None
+    text, err = grid_accuracy(section, AeroOptions(cells_per_chord=24), "quick", 1.05e8)
+    assert err is None and text.startswith("no grid study covers 'quick' on 24 cells per chord"), text
+
+
 def test_the_sst_walls_option_is_checked_reaches_the_preset_and_the_stage_key():
     from dataclasses import replace as dc_replace
 
