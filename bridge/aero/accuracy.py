@@ -82,5 +82,5 @@ def grid_accuracy(section, aero_options, quality: str, reynolds: float) -> tuple
                 "error is unknown; compare it with the preset's own grid"), None
     lo, hi = record.vc_low_percent
     return (f"no grid study covers this deck and flow model: the grid error of its V_c on '{quality}' is unknown "
-            f"(on the Great Belt deck with k-omega SST the same preset's V_c lies {lo:g}-{hi:g} % low; "
-            "docs/aero.md); run a finer preset to see how far it moves"), None
+            f"(on the Great Belt deck with k-omega SST on the overset pair the same preset's V_c lies {lo:g}-{hi:g} % "
+            "low; docs/aero.md); run a finer preset to see how far it moves"), None
