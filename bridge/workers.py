@@ -141,6 +141,6 @@ def worker_pool(workers: int, context=None, initializer: Callable | None = None,
             with contextlib.suppress(BaseException):
                 pool.shutdown(wait=True)
                 if manager is not None:
-                    manager.join(grace_s)
+                    manager.join(max(grace_s, 5.0))
         raise
     pool.shutdown(wait=True)

@@ -84,7 +84,6 @@ class AeroOptions:
     mean_angle_deg: float = 0.0
     cells_per_chord: int = 0
 
-
     def __post_init__(self):
         check_flow_model(self.turbulence, self.sst_walls, USER_SST_WALLS)
         check_range("aero.wind_speed_m_s", self.wind_speed_m_s, 0.0, 200.0, low_open=True)

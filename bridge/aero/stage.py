@@ -63,6 +63,7 @@ class AeroResult:
     sst_walls: str = "equilibrium"     # [aero] sst_walls: "equilibrium", "function" or "blended" (with "sst")
     grid_study: str = ""               # the preset's grid error as measured (bridge.aero.accuracy), or "none"
     vc_grid_error_percent: tuple[float, float] | None = None   # V_c below the grid-converged one (low, high) %
+    cells_per_chord: int = 0           # the body grid's cells per chord (the preset's, or [aero] cells_per_chord)
 
     @property
     def reduced_velocity(self) -> np.ndarray:
@@ -165,7 +166,7 @@ def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
     data = AeroResult(section.describe(), quality, q.physics.reynolds, cells, Ks, frf, stderr, model,
                       tuple(records), warning, static, tuple(static_records), aopts.grid, grids, q.physics.turbulence,
                       q.physics.sst_walls,
-                      study, vc_error)
+                      study, vc_error, q.grid.cells_per_chord)
     return StageOutput(summary=_summary(data), write_h5=lambda g: _write_h5(g, data), report=_report(data),
                        figures=_figures(data), data=data)
 
@@ -262,6 +263,7 @@ def _summary(d: AeroResult) -> dict[str, Any]:
                          "aero.turbulence": d.turbulence,
                          **({"aero.sst_walls": d.sst_walls} if d.turbulence == "sst" else {}),
                          "aero.cases": len(d.records), "aero.grid_cells": d.cells, "aero.grid": d.grid,
+                         "aero.cells_per_chord": d.cells_per_chord,
                          "aero.reduced_velocity_min": float(d.reduced_velocity.min()),
                          "aero.reduced_velocity_max": float(d.reduced_velocity.max()),
                          "aero.cfd_wall_s": float(sum(r["wall_s"] for r in d.records + d.static_records)),
@@ -341,7 +343,8 @@ def _report(d: AeroResult) -> str:
     theo = derivatives_from_frf(d.reduced_frequency, Theodorsen().frf(d.reduced_frequency, 1.0))
     der = d.derivatives
     lines = ["## Aerodynamics of the deck section from forced-motion CFD (thesis 5.2-5.3)", "",
-             f"{d.section}; preset {d.quality!r}, {d.grid} grid ({d.grids}), " + (
+             f"{d.section}; preset {d.quality!r}, {d.grid} grid of {d.cells_per_chord} cells per chord "
+             f"({d.grids}), " + (
                  f"laminar at Re = {d.reynolds:g} (a low Reynolds number: the deck's, about 1e8, needs "
                  "[aero] turbulence = \"sst\")" if d.turbulence == "laminar" else
                  f"URANS with the k-omega SST model (2003 variant) and {_WALLS[d.sst_walls]} at Re = "
