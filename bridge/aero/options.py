@@ -7,7 +7,8 @@ Keys (all optional):
     cells_per_chord       the body grid's cells per chord instead of the preset's (8-2000; default 0: the
                           preset's): the same preset on another grid, to see how far a result moves with the
                           grid (the background and, on "body_fitted", the O-grid's nodes around follow it); no
-                          grid study covers a changed grid, and the headline says so
+                          grid study covers a changed grid, and the headline says so; "tiny" (--quick) keeps
+                          its own grid
     reduced_velocities    U/(fB) of the forced-motion runs (default 4, 6, 8, 10, 12, 16; at least 2):
                           the flutter search may use reduced frequencies K = 2 pi / (U/(fB)) only inside
     heave_rate            heave velocity amplitude over the wind speed, udot_0 / V (default the thesis's

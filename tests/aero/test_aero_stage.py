@@ -167,6 +167,7 @@ def test_cells_per_chord_puts_the_preset_on_another_grid_and_the_headline_loses_
         section, q = scenario_preset(finer)
         assert q.name == "quick" and q.grid.cells_per_chord == 24
         assert scenario_preset(dc_replace(sc, aero=AeroOptions(grid=grid)))[1].grid.cells_per_chord == 16
+        assert scenario_preset(finer, "tiny")[1].grid.cells_per_chord == 12   # --quick: a smoke run stays coarse
     keys = {stage_key("aero", dc_replace(sc, aero=AeroOptions(cells_per_chord=c)), {}, False) for c in (0, 16, 24)}
     assert len(keys) == 3
     for own in (0, 16):   # the preset's own grid
