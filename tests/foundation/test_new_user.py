@@ -166,6 +166,7 @@ def test_a_chain_of_references_scales_once_from_the_full_bridge(tmp_path):
 
 
 # ------------------------------------------------------------------------------ 5: a CFD deck wider than the structure
+@pytest.mark.slow   # ~4 s (runs of the command): runs in CI with -m slow
 def test_a_cfd_deck_of_another_width_than_the_girder_is_refused_before_any_work(tmp_path):
     wide = write(tmp_path / "wide_deck.toml", 'reference = "great_belt"\nmain_span_m = 1624.0\n'
                  '[deck_section]\nshape = "streamlined_box"\nchord_m = 40.0\n')

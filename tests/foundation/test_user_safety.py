@@ -52,6 +52,7 @@ def copy_scenario(src: str, dst: Path, edit=None) -> Path:
 
 
 # ------------------------------------------------------------------------------ results never lost
+@pytest.mark.slow   # ~4 s (runs of the command): runs in CI with -m slow
 def test_rerun_into_a_result_folder_is_refused_and_overwrite_keeps_the_users_files(tmp_path):
     out = str(tmp_path)
     # a run of more stages (cable and fem: the flutter stage would only add time) ...
@@ -135,6 +136,7 @@ def test_the_output_folder_is_checked_before_any_work(tmp_path):
     assert "--out" in line and "cannot write" in line
 
 
+@pytest.mark.slow   # ~4 s (runs of the command): runs in CI with -m slow
 def test_every_output_file_gets_the_same_mode(tmp_path):
     proc = cli("great_belt", "model_c", "--stages", "cable", "--quick", "--quiet", "--out", str(tmp_path / "run"))
     assert proc.returncode == 0, proc.stderr
