@@ -69,7 +69,7 @@ def grid_accuracy(section, aero_options, quality: str, reynolds: float) -> tuple
     the run: the sentence then says so)."""
     record = GRID_STUDY.get(quality)
     cells = aero_options.cells_per_chord
-    own_grid = cells in (0, QUALITY[quality].grid.cells_per_chord) if quality in QUALITY else not cells
+    own_grid = cells in (0, QUALITY[quality].grid.cells_per_chord)   # quality: a checked preset name
     if record is not None and own_grid and covered_by_study(section, aero_options, reynolds):
         lo, hi = record.vc_low_percent
         return (f"grid study of this deck and flow model: on '{quality}' V_c lies {lo:g}-{hi:g} % below the "

@@ -298,7 +298,7 @@ def hole_ring(ogrid: CurvilinearGrid, h: float, overlap: float = 4.0, ring_overl
     against 5.5817) and dp out of its band. On a grid graded from y+ ~ 1 or 50, though, half the rings lie within a
     few hundredths of a chord of the wall: the Great Belt deck's hole then sat 0.02 chord out, under background
     cells of 0.12, and the coarse background carried the deck's near field (its lift in pitch 40-80 % of the
-    plate's, not converging; docs/aero.md). ValueError where no ring lies ``overlap`` background cells inside."""
+    plate's, not converging). ValueError where no ring lies ``overlap`` background cells inside."""
     depth = np.hypot(ogrid.x - ogrid.x[-1], ogrid.y - ogrid.y[-1]).min(axis=1)   # from the outer ring
     out = np.hypot(ogrid.x - ogrid.x[0], ogrid.y - ogrid.y[0]).min(axis=1)       # from the wall
     j = np.arange(ogrid.nj + 1)
