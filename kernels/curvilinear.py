@@ -100,22 +100,24 @@ def _limited(qu: wp.float64, qd: wp.float64, quu: wp.float64):
 
 @wp.func
 def _face_j(ext: wp.array2d(dtype=wp.float64), Fj: wp.array2d(dtype=wp.float64),
-            implicit_j: wp.array2d(dtype=wp.int32), upwind: int, f: int, i: int):
-    """The advective flux through j-face f (between rings f-1 and f; ext row r is ring r-1); the wall face's none."""
+            implicit_j: wp.array2d(dtype=wp.int32), correct: int, f: int, i: int):
+    """The advective flux through j-face f (between rings f-1 and f; ext row r is ring r-1); the wall face's none;
+    with ``correct`` an implicit face's van Leer flux less the upwind one (``advection``)."""
     F = Fj[f, i]
     out = wp.float64(0.0)
     if f > 0:
-        if implicit_j[f, i] != 0:
-            if upwind != 0:
-                if F > wp.float64(0.0):
-                    out = F * ext[f, i]
-                else:
-                    out = F * ext[f + 1, i]
+        limited = wp.float64(0.0)
+        if F > wp.float64(0.0):
+            limited = _limited(ext[f, i], ext[f + 1, i], ext[f - 1, i])
         else:
+            limited = _limited(ext[f + 1, i], ext[f, i], ext[f + 2, i])
+        if correct != 0 and implicit_j[f, i] != 0:
+            upwinded = ext[f + 1, i]
             if F > wp.float64(0.0):
-                out = F * _limited(ext[f, i], ext[f + 1, i], ext[f - 1, i])
-            else:
-                out = F * _limited(ext[f + 1, i], ext[f, i], ext[f + 2, i])
+                upwinded = ext[f, i]
+            out = F * (limited - upwinded)
+        else:
+            out = F * limited
     return out
 
 
@@ -143,11 +145,12 @@ def _face_i(ext: wp.array2d(dtype=wp.float64), Fi: wp.array2d(dtype=wp.float64),
 
 @wp.kernel
 def advection(ext: wp.array2d(dtype=wp.float64), Fi: wp.array2d(dtype=wp.float64),
-              Fj: wp.array2d(dtype=wp.float64), implicit_j: wp.array2d(dtype=wp.int32), upwind: int,
+              Fj: wp.array2d(dtype=wp.float64), implicit_j: wp.array2d(dtype=wp.int32), correct: int,
               area: wp.array2d(dtype=wp.float64), ni: int, out: wp.array2d(dtype=wp.float64)):
     """div(q (u - u_g)) per cell area: ``ext`` (nj + 3, ni) is q with the wall's reflection (row 0) and two ghost
     rings (rows nj + 1, nj + 2); Fi, Fj the relative fluxes; van Leer's limited upwind face values along the grid
-    lines, the implicit j-faces none (``upwind`` 0) or first-order upwind (1)."""
+    lines; with ``correct`` 1, on the implicit j-faces (``implicit_j``) van Leer's less first-order upwind's
+    (the deferred correction: a line solve carries the upwind part)."""
     j = wp.tid()
     f_m = _face_i(ext, Fi, ni, j, 0)          # the cell's minus i-face, carried from the cell before
     for i in range(ni):
@@ -155,8 +158,8 @@ def advection(ext: wp.array2d(dtype=wp.float64), Fi: wp.array2d(dtype=wp.float64
         if ip1 == ni:
             ip1 = 0
         f_p = _face_i(ext, Fi, ni, j, ip1)
-        out[j, i] = (f_p - f_m + _face_j(ext, Fj, implicit_j, upwind, j + 1, i)
-                     - _face_j(ext, Fj, implicit_j, upwind, j, i)) / area[j, i]
+        out[j, i] = (f_p - f_m + _face_j(ext, Fj, implicit_j, correct, j + 1, i)
+                     - _face_j(ext, Fj, implicit_j, correct, j, i)) / area[j, i]
         f_m = f_p
 
 

@@ -35,8 +35,9 @@ for first-cell centres at y+ 18-75 (docs/validation.md, row 17c).
 Time step: one step per flow step, after it (segregated: the coefficients and nu_t from the flow's new
 velocity; nu_t handed on is the new k and omega's), in delta form,
   (D - dt L_i) D^-1 (D - dt L_j) dq = dt R(q),   D = 1 + dt (the destruction rate),
-R the whole explicit right-hand side (advection, diffusion, sources less sinks), L_j with the flat cells'
-advection across the rings (first-order upwind there, as the flow's): the approximate factorisation makes the
+R the whole explicit right-hand side (advection by van Leer's faces everywhere, diffusion, sources less sinks),
+L_j with the flat cells' advection across the rings (its first-order upwind Jacobian, as the flow's line solve
+has): the approximate factorisation makes the
 thin wall cells' diffusion and advection and the stiff destruction implicit, and a settled state satisfies
 R = 0 exactly, whatever the step.  First order in time (the flow's velocity is second order; the model lags it
 by a step anyway).
@@ -247,7 +248,7 @@ class CurvilinearSST:
         flow = self.flow
         gi, gj = self._face_diffusivity(*sigmas)
         wall_face, wall_node = wall
-        adv = flow._advection(q, flow._ring_values(q, wall_face, ghosts), Fi_rel, Fj_rel, implicit="upwind")
+        adv = flow._advection(q, flow._ring_values(q, wall_face, ghosts), Fi_rel, Fj_rel, correct=False)
         one, zero = np.ones(flow.grid.ni), np.zeros(flow.grid.ni)
         cross, around, rings = flow.diffusion_parts(q, gi, gj, wall_face, wall_node, ghosts, one, zero)
         src, snk = terms
