@@ -37,7 +37,8 @@ IMPLICIT_ASPECT (along the wall over across it; ``grid.implicit_j``) the advecti
 too, by deferred correction: first-order upwind in the same line solves, and van Leer's face value less the
 upwind one explicit, so that the scheme in space stays van Leer's (Khosla and Rubin 1974; what OpenFOAM's
 bounded schemes do): at Re 1e8 the flow crossing the thin cells near a sharp corner would otherwise set a step
-tens of times shorter (the Great Belt deck's O-grid took 16 steps to the background's one, 6 with it).  Then the
+a hundred times shorter (with the implicit faces only in cells flatter than 10:1 and the two rates' maxima
+added, the Great Belt deck's O-grid took 16 steps to the background's one; 6 now).  Then the
 projection, incremental (van
 Kan 1986): the predicted face fluxes (Rhie and Chow's interpolation: the cell pressure gradient taken out, the
 face's put back, both weighted by c / A_P, A_P the diagonal of the implicit operator the predictor solved:
@@ -47,8 +48,9 @@ faces' values extrapolated along the grid lines), p += phi, c = dt over BDF2's l
 weight: in the thin wall cells the implicit diffusion makes A_P a hundred or more, so the predictor took out only
 c / A_P times the cell gradient; put back with c, the surplus entered the faces' fluxes, and at a sharp convex
 corner, where the two wall cells' normal gradients meet across one face, it pumped a spurious loop of several U
-through the first rings, growing with the step and setting it (the Great Belt's nose).  The step is set by the
-convective Courant number of the explicit faces (and the explicit cross terms of skewed cells).
+through the first rings, growing with the step and setting it (the Great Belt's nose).  The step: each cell's
+explicit rates added (the convective Courant number of its explicit faces, the cross terms of skewed cells),
+the fastest cell's.
 
 The outer boundary's velocity (two rings of ghost cells) and face fluxes come from an ``outer`` provider:
 :class:`Farfield` (a uniform stream), or the Cartesian background of an overset pair.

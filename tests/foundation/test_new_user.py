@@ -133,6 +133,7 @@ def test_a_cfd_flutter_speed_comes_with_its_grid_error_or_says_it_has_none():
     for quality in ("standard", "fine"):
         text, err = grid_accuracy(deck, body, quality, 1.05e8)
         assert err is None and text.startswith(f"no grid study covers the '{quality}' preset on the body-fitted grid")
+    assert covered_by_study(deck, body, 1.05e8) and not covered_by_study(deck, body, 5.2e7)   # run at 1.05e8 only
     text, err = grid_accuracy(Rectangle(31.0, 6.2), body, "quick", 1.05e8)
     assert err is None and "on the body-fitted pair the same preset's V_c lies 1-3 % low" in text, text
     # the other aerodynamics name themselves
