@@ -64,32 +64,47 @@ BODY_FITTED_STUDY = {
                         "assumed order of 0.8-2"),
 }
 
-# The deck and flow model each study ran (a run must match them for its preset's record to apply); the
-# Reynolds numbers between which the responses were shown not to depend on it.
-_STUDIED_FLOW = {"turbulence": "sst", "sst_walls": "equilibrium", "grid": "overset", "excitation": "single"}
-_STUDIED_FLOW_BODY_FITTED = {"turbulence": "sst", "grid": "body_fitted", "excitation": "single"}
-_STUDIED_REYNOLDS = (5.0e7, 2.0e8)
-_STUDIED_REYNOLDS_BODY_FITTED = (1.0e8, 1.1e8)
+@dataclass(frozen=True)
+class _Study:
+    """One grid study: its records by preset, the flow model a run must match for them to apply (on the
+    body-fitted pair the wall is resolved whatever ``sst_walls``), the Reynolds numbers between which the
+    responses were shown not to depend on it, and the pair's name in messages."""
+
+    records: dict
+    flow: dict
+    reynolds: tuple[float, float]
+    pair: str
+
+
+_STUDIES = {
+    "overset": _Study(GRID_STUDY, {"turbulence": "sst", "sst_walls": "equilibrium", "grid": "overset",
+                                   "excitation": "single"}, (5.0e7, 2.0e8), "overset"),
+    "body_fitted": _Study(BODY_FITTED_STUDY, {"turbulence": "sst", "grid": "body_fitted", "excitation": "single"},
+                          (1.0e8, 1.1e8), "body-fitted"),
+}
+
+
+def _study(aero_options) -> _Study:
+    """The study of the run's grid (a single grid has none of its own: the overset pair's is quoted)."""
+    return _STUDIES.get(aero_options.grid, _STUDIES["overset"])
 
 
 def covered_by_study(section, aero_options, reynolds: float) -> bool:
-    """True when the deck, its flow model and its Reynolds number are those of a grid study (the overset
-    pair's, or the body-fitted pair's; on the body-fitted pair the wall is resolved whatever ``sst_walls``)."""
+    """True when the deck, its flow model and its Reynolds number are those of its grid's study."""
     from bridge.cfd.sections import great_belt_section
 
-    body_fitted = aero_options.grid == "body_fitted"
-    flow = _STUDIED_FLOW_BODY_FITTED if body_fitted else _STUDIED_FLOW
-    low, high = _STUDIED_REYNOLDS_BODY_FITTED if body_fitted else _STUDIED_REYNOLDS
+    study = _study(aero_options)
     same_deck = section.to_mapping() == great_belt_section().to_mapping()
-    same_flow = all(getattr(aero_options, k) == v for k, v in flow.items())
-    return same_deck and same_flow and low <= reynolds <= high
+    same_flow = all(getattr(aero_options, k) == v for k, v in study.flow.items())
+    return same_deck and same_flow and study.reynolds[0] <= reynolds <= study.reynolds[1]
 
 
 def grid_accuracy(section, aero_options, quality: str, reynolds: float) -> tuple[str, tuple[float, float] | None]:
     """A sentence on the grid error of a CFD V_c of this deck, flow model and preset, and the range (low,
     high) in per cent by which the V_c lies below the grid-converged estimate (None where no study covers
     the run: the sentence then says so)."""
-    record = (BODY_FITTED_STUDY if aero_options.grid == "body_fitted" else GRID_STUDY).get(quality)
+    study = _study(aero_options)
+    record = study.records.get(quality)
     cells = aero_options.cells_per_chord
     own_grid = cells in (0, QUALITY[quality].grid.cells_per_chord)   # quality: a checked preset name
     if record is not None and own_grid and covered_by_study(section, aero_options, reynolds):
@@ -103,7 +118,6 @@ def grid_accuracy(section, aero_options, quality: str, reynolds: float) -> tuple
         return (f"no grid study covers '{quality}' on {cells} cells per chord (aero.cells_per_chord): its grid "
                 "error is unknown; compare it with the preset's own grid"), None
     lo, hi = record.vc_low_percent
-    pair = "body-fitted" if aero_options.grid == "body_fitted" else "overset"
     return (f"no grid study covers this deck and flow model: the grid error of its V_c on '{quality}' is unknown "
-            f"(on the Great Belt deck with k-omega SST on the {pair} pair the same preset's V_c lies {lo:g}-{hi:g} % "
-            "low; docs/aero.md); run a finer preset to see how far it moves"), None
+            f"(on the Great Belt deck with k-omega SST on the {study.pair} pair the same preset's V_c lies "
+            f"{lo:g}-{hi:g} % low; docs/aero.md); run a finer preset to see how far it moves"), None
