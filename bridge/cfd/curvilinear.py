@@ -69,7 +69,7 @@ from .flow import LAMINAR, FlowBase
 
 __all__ = ["CurvilinearGrid", "CurvilinearFlow", "Farfield", "polar_grid"]
 
-IMPLICIT_ASPECT = 1.0   # cells flatter than this (along the wall / across) advect across the rings implicitly
+IMPLICIT_ASPECT = 2.0   # cells flatter than this (along the wall / across) advect across the rings implicitly
 
 
 def _rot(theta: float) -> np.ndarray:

@@ -60,24 +60,22 @@ def test_the_o_grid_sub_cycles_to_the_background_step():
     assert np.allclose(mid, 0.75 * f0 + 0.25 * f1, rtol=0, atol=1e-14) and not np.allclose(f0, f1, rtol=0, atol=1e-9)
 
 
-@pytest.mark.slow   # 12 s
+@pytest.mark.slow   # 3 s
 def test_the_rotating_cylinder_gets_the_lift_of_the_o_grid_alone():
     """Circulation crosses the interface: a cylinder turning at half the stream's speed on its surface
     (Re 40), its O-grid reaching 2 diameters over a background of D / 5 twenty diameters across, against the
-    O-grid alone with its farfield at 10 diameters, at t = 3.  The start is a transient, and the pair's O-grid
-    steps in equal parts of the background's step, the O-grid alone at its own: their lifts differ by the two
-    time errors, which the implicit advection across its rings (cells flatter than wide) makes larger -
-    measured 1.3 % at Courant 0.5, 1.0 % at 0.25, 0.54 % at 0.125 (the run here); C_D 1.939 and 1.951."""
+    O-grid alone with its farfield at 10 diameters, at t = 3.  Measured: C_L -1.4940 and -1.4921 (0.13 %),
+    C_D 1.982 and 1.958 (1.2 %)."""
     om = 1.0
     motion = PrescribedMotion(lambda t: (0.0, 0.0, om * t), lambda t: (0.0, 0.0, om))
-    pair = _pair(motion, cfl=0.125)
+    pair = _pair(motion)
     run(pair, 3.0)
     x, y = polar_grid(0.5, 10.0, 64, 0.02, 1.1)
-    alone = CurvilinearFlow(CurvilinearGrid(x, y), 1 / 40, motion, Farfield(1.0, 0.0), cfl=0.125)
+    alone = CurvilinearFlow(CurvilinearGrid(x, y), 1 / 40, motion, Farfield(1.0, 0.0))
     alone.set_uniform_flow(1.0)
     run(alone, 3.0)
     (cd_pair, cl_pair), (cd_alone, cl_alone) = 2 * pair.total_force[:2], 2 * alone.total_force[:2]
-    assert cl_alone < -1.0 and abs(cl_pair / cl_alone - 1) < 0.0075, (cl_pair, cl_alone)
+    assert cl_alone < -1.0 and abs(cl_pair / cl_alone - 1) < 0.005, (cl_pair, cl_alone)
     assert abs(cd_pair / cd_alone - 1) < 0.03, (cd_pair, cd_alone)
 
 
