@@ -3,8 +3,9 @@
 Every combination of the listed main spans and ``--vary`` values is one case, run through the pipeline
 like ``python -m bridge.scenario`` and written to ``OUT/<sweep>/cases/<case>/``.  The sweep is resumable:
 a case whose folder holds a finished run of the same inputs and stages is skipped (results are renamed
-into place only when finished).  Stages shared by cases (same inputs) come from the stage cache
-``OUT/.cache/`` (``--no-cache`` recomputes).  Cases
+into place only when finished).  Stages shared by cases (same inputs: the aero stage's CFD of one deck) are
+computed once, before the cases start, into the stage cache ``OUT/.cache/``, and the cases read them from there
+(``--no-cache`` recomputes in every case).  Cases
 run in parallel on local processes (``--workers``, default 2) or on an existing Dask cluster
 (``--scheduler tcp://host:8786``; needs the optional extra ``pip install -e ".[dask]"``).
 
@@ -293,6 +294,8 @@ def run_sweep(cases: list[Case], sweep_dir: Path, stages: list[str] | None = Non
     cases_dir = sweep_dir / "cases"
     cases_dir.mkdir(parents=True, exist_ok=True)
     status: dict[str, str] = {}
+    if cache_dir is not None:
+        run_shared_stages(cases, stages, quick, Path(cache_dir), say, scheduler)
     t0 = time.perf_counter()
     cache = None if cache_dir is None else str(cache_dir)
 
@@ -327,6 +330,35 @@ def run_sweep(cases: list[Case], sweep_dir: Path, stages: list[str] | None = Non
             for fut in as_completed(futs):
                 report(*fut.result())
     return status
+
+
+def run_shared_stages(cases: list[Case], stages: list[str] | None, quick: bool, cache_dir: Path, say=print,
+                      scheduler: str | None = None) -> int:
+    """Compute each shared stage (``Stage.shared``: the aero stage's CFD, which bridges with one deck share) once,
+    here, before the cases start, and leave it in the stage cache for them; return how many were run or read.
+
+    Else the cases that start together would all miss the cache and each compute the same CFD, on one core each
+    (two workers: twice the work in twice the time).  Here a stage runs as ``python -m bridge.scenario`` runs it,
+    with its own parallel cases (or on ``scheduler``) and its progress shown.  A failure is said and left to the
+    cases, which report it as their error."""
+    from .pipeline import plan_stages, run_stages, stage_keys
+    from .stages import STAGES, RunOptions
+
+    options = RunOptions(progress=say, cache=cache_dir, quick=quick, scheduler=scheduler)
+    seen: set[str] = set()
+    for case in cases:
+        scenario = case.load()
+        keys = stage_keys(scenario, stages, options)
+        for name in plan_stages(scenario, stages):
+            if not STAGES[name].shared or keys[name] in seen:
+                continue
+            seen.add(keys[name])
+            say(f"{name}: shared by the cases, computed (or read from the cache) once before they start")
+            try:
+                run_stages(scenario, [name], options)
+            except Exception as err:   # InputError, ConvergenceError or other: each case meets it again
+                say(f"{name}: {type(err).__name__}: {err} (the cases that need it will report it)")
+    return len(seen)
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -3,7 +3,8 @@
 import h5py
 import numpy as np
 
-from bridge.sweep import main, plan_cases
+import bridge.sweep as sweep
+from bridge.sweep import main, plan_cases, run_shared_stages
 
 
 def test_plan_is_the_cartesian_product():
@@ -51,3 +52,32 @@ def test_collect_tolerates_mixed_numeric_and_text_values(tmp_path):
     with h5py.File(tmp_path / "sweep.h5") as h5:
         got = h5["results/flutter.critical_speed_m_s"][:]
     assert got[0] == 86.5 and np.isnan(got[1])
+
+
+def test_a_stage_the_cases_share_runs_once_before_they_start(tmp_path, monkeypatch):
+    """Three spans of one deck share its CFD (the aero stage): it is run once, not by each case at once (two
+    workers missing the cache together each computed it, on one core each); two grids are two CFDs; a
+    bridge with thin-plate aerodynamics has none."""
+    calls = []
+    monkeypatch.setattr("bridge.pipeline.run_stages", lambda sc, stages, options:
+                        calls.append((sc.geometry.main_span_m, sc.aero.cells_per_chord, stages)))
+    quiet = lambda m: None  # noqa: E731
+    assert run_shared_stages(plan_cases("great_belt_body_fitted", [1624.0, 2000.0, 3000.0], {}), None, False,
+                             tmp_path, quiet) == 1
+    assert calls == [(1624.0, 0, ["aero"])]
+    calls.clear()
+    assert run_shared_stages(plan_cases("great_belt_body_fitted", [2000.0], {"aero.cells_per_chord": [0, 24]}),
+                             None, False, tmp_path, quiet) == 2
+    assert [c[1] for c in calls] == [0, 24]
+    calls.clear()
+    assert run_shared_stages(plan_cases("great_belt", [1624.0, 2000.0], {}, "theodorsen"), None, False,
+                             tmp_path, quiet) == 0 and calls == []
+
+
+def test_the_sweep_runs_the_shared_stages_first_unless_the_cache_is_off(tmp_path, monkeypatch):
+    seen = []
+    monkeypatch.setattr(sweep, "run_shared_stages", lambda cases, stages, quick, cache_dir, say, scheduler:
+                        seen.append((len(cases), cache_dir)))
+    args = ["great_belt", "--main-span", "1624,2000", "--stages", "cable", "--workers", "1", "--out", str(tmp_path)]
+    assert main(args) == 0 and seen == [(2, tmp_path / ".cache")]
+    assert main([*args, "--no-cache", "--name", "again"]) == 0 and len(seen) == 1
