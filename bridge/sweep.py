@@ -294,8 +294,9 @@ def run_sweep(cases: list[Case], sweep_dir: Path, stages: list[str] | None = Non
     cases_dir = sweep_dir / "cases"
     cases_dir.mkdir(parents=True, exist_ok=True)
     status: dict[str, str] = {}
-    if cache_dir is not None:
-        run_shared_stages(cases, stages, quick, Path(cache_dir), say, scheduler)
+    if cache_dir is not None:   # for the cases still to run (a resumed sweep's finished ones need nothing)
+        todo = [c for c in cases if _finished_with(cases_dir / c.name) != case_key(c, stages, quick)]
+        run_shared_stages(todo, stages, quick, Path(cache_dir), say, scheduler)
     t0 = time.perf_counter()
     cache = None if cache_dir is None else str(cache_dir)
 

@@ -29,7 +29,7 @@ import argparse
 import json
 import math
 import sys
-from dataclasses import fields, replace
+from dataclasses import replace
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
@@ -51,14 +51,15 @@ KEYS = ("flutter.critical_speed_m_s", "flutter.frequency_hz", "flutter.mode_pair
         "aero.static.moment_coefficient", "aero.cfd_wall_s")
 
 
-def _parse_changes(items: list[str], section) -> dict[str, float]:
-    known = {f.name: f for f in fields(section) if f.init}
+def _parse_changes(items: list[str]) -> dict[str, float]:
     out = {}
     for item in items:
         name, _, value = item.partition("=")
-        if name not in known or name in ("chord_m", "railings") or not value:
-            raise InputError("--change", item, "FIELD=VALUE with FIELD one of the outline's dimensions: "
-                             + ", ".join(n for n in known if n not in ("chord_m", "railings")))
+        if name not in DEFAULT_CHANGES or not value:
+            raise InputError("--change", item, "FIELD=VALUE with FIELD one of the outline's ASSUMED dimensions: "
+                             + ", ".join(DEFAULT_CHANGES))
+        if name in out:
+            raise InputError("--change", item, f"{name} is given twice: one value each")
         try:
             out[name] = float(value)
         except ValueError:
@@ -67,6 +68,11 @@ def _parse_changes(items: list[str], section) -> dict[str, float]:
 
 
 def _outline(scenario):
+    from bridge.pipeline import wants_cfd
+
+    if not wants_cfd(scenario):
+        raise InputError("scenario", scenario.name, "its flutter stage must take the deck's aerodynamics from the "
+                         "CFD ([flutter] aerodynamics = \"cfd\"): else the outline changes nothing")
     section = scenario.deck_section
     if section is None:
         from bridge.cfd.sections import great_belt_section
@@ -122,7 +128,7 @@ def main(argv=None) -> int:
     try:
         scenario = load_scenario(args.scenario)
         section = _outline(scenario)
-        changes = _parse_changes(args.change, section) if args.change else dict(DEFAULT_CHANGES)
+        changes = _parse_changes(args.change) if args.change else dict(DEFAULT_CHANGES)
         variants = [(f"{k} {getattr(section, k):g} -> {v:g}", replace(section, **{k: v})) for k, v in changes.items()]
     except InputError as err:
         print(f"error: {err}", file=sys.stderr)
@@ -137,15 +143,17 @@ def main(argv=None) -> int:
         print(f"outline {i}/{len(variants)}: {label}", flush=True)
         try:
             rows.append(_row(label, run_stages(replace(scenario, deck_section=outline), ["flutter"], options)))
-        except (InputError, ConvergenceError) as err:   # e.g. an outline the O-grid cannot mesh: said, and on
-            print(f"outline {label}: not computed: {err}", flush=True)
-            rows.append({"change": label, "error": str(err), **{k: None for k in KEYS}})
+        except Exception as err:   # e.g. an outline the O-grid cannot mesh: said, and on to the next
+            why = str(err) if isinstance(err, (InputError, ConvergenceError)) else f"{type(err).__name__}: {err}"
+            print(f"outline {label}: not computed: {why}", flush=True)
+            rows.append({"change": label, "error": why, **{k: None for k in KEYS}})
     table = _table(rows)
     print(table)
     out = args.out or Path("out") / "outline_sensitivity" / f"{scenario.name}.json"
     out.parent.mkdir(parents=True, exist_ok=True)
     clean = [{k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in r.items()} for r in rows]
-    atomic_write_text(out, json.dumps({"command": "python tools/outline_sensitivity.py " + " ".join(sys.argv[1:]),
+    command = " ".join(sys.argv[1:] if argv is None else argv)
+    atomic_write_text(out, json.dumps({"command": "python tools/outline_sensitivity.py " + command,
                                        "rows": clean, "table": table}, indent=1))
     print(f"written {out}")
     return 1 if any(r.get("error") for r in rows) else 0

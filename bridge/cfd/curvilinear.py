@@ -27,31 +27,31 @@ metric, second order on smooth grids, and a nine-point pressure stencil.  The ex
 diffusion, cell gradients) and the line solves are Warp kernels (kernels/curvilinear.py); the pressure's
 constant matrix is factorised once by SuperLU.
 
-Time step: second-order backward differences (BDF2) with the explicit terms extrapolated from the last two
-steps (SBDF2; Ascher, Ruuth and Wetton 1995) - advection (van Leer's limited upwinding along the grid lines),
-the frame's term and the diffusion's cross-derivative terms explicit, the rest of the diffusion implicit: around
-each ring and across the rings, approximately factorised into one line solve per grid line each way
-(kernels/curvilinear.py), so that neither the thin wall cells nor the fine spacing along the wall limit the
-step; BDF2 damps the stiff modes that Crank-Nicolson would leave ringing.  Between cells flatter than
-IMPLICIT_ASPECT = 2 (along the wall over across it; ``grid.implicit_j``) the advection across the rings is implicit
-too, by deferred correction: first-order upwind in the same line solves, and van Leer's face value less the
-upwind one explicit, so that the scheme in space stays van Leer's (Khosla and Rubin 1974; what OpenFOAM's
-bounded schemes do): at Re 1e8 the flow crossing the thin cells near a sharp corner would otherwise set a step
-a hundred times shorter (with the implicit faces only in cells flatter than 10:1 and the two rates' maxima
-added, the Great Belt deck's O-grid took 16 steps to the background's one; 6 now).  Not in cells barely
-flat: there the implicit upwind part costs time accuracy (at 1 instead of 2 the start-up lift of a rotating
-cylinder's O-grid, cells of aspect 1-2.5, moved 3.6 % at Courant 0.5), and they do not limit the step.  Then
-the projection, incremental (van Kan 1986): the predicted face fluxes (Rhie and Chow's interpolation: the cell pressure gradient taken out, the
-face's put back, both weighted by c / A_P, A_P the diagonal of the implicit operator the predictor solved:
-SIMPLE's d = V / a_P, OpenFOAM's rAU), D G phi = D F* / c with the nine-point face gradient (a constant matrix,
-factorised once), F = F* - c G phi on the faces, u = u* - c grad phi at the centres (Green-Gauss, the boundary
-faces' values extrapolated along the grid lines), p += phi, c = dt over BDF2's leading coefficient.  Why that
-weight: in the thin wall cells the implicit diffusion makes A_P a hundred or more, so the predictor took out only
-c / A_P times the cell gradient; put back with c, the surplus entered the faces' fluxes, and at a sharp convex
-corner, where the two wall cells' normal gradients meet across one face, it pumped a spurious loop of several U
-through the first rings, growing with the step and setting it (the Great Belt's nose).  The step: each cell's
-explicit rates added (the convective Courant number of its explicit faces, the cross terms of skewed cells),
-the fastest cell's.
+Time step: second-order backward differences (BDF2) with the explicit terms extrapolated from the last two steps
+(SBDF2; Ascher, Ruuth and Wetton 1995) - advection (van Leer's limited upwinding along the grid lines), the
+frame's term and the diffusion's cross-derivative terms explicit, the rest of the diffusion implicit: around each
+ring and across the rings, approximately factorised into one line solve per grid line each way
+(kernels/curvilinear.py), so that neither the thin wall cells nor the fine spacing along the wall limit the step;
+BDF2 damps the stiff modes that Crank-Nicolson would leave ringing.  Between cells flatter than
+IMPLICIT_ASPECT = 2 (along the wall over across it; ``grid.implicit_j``) the advection across the rings is
+implicit too, by deferred correction: first-order upwind in the same line solves, and van Leer's face value less
+the upwind one explicit, so that the scheme in space stays van Leer's (Khosla and Rubin 1974; what OpenFOAM's
+bounded schemes do): at Re 1e8 the flow crossing the thin cells near a sharp corner would otherwise set a step a
+hundred times shorter (with the implicit faces only in cells flatter than 10:1 and the two rates' maxima added,
+the Great Belt deck's O-grid took 16 steps to the background's one; 6 now).  Not in cells barely flat: there the
+implicit upwind part costs time accuracy (at 1 instead of 2 the start-up lift of a rotating cylinder's O-grid,
+cells of aspect 1-2.5, moved 3.6 % at Courant 0.5), and they do not limit the step.  Then the projection,
+incremental (van Kan 1986): the predicted face fluxes (Rhie and Chow's interpolation: the cell pressure gradient
+taken out, the face's put back, both weighted by c / A_P, A_P the diagonal of the implicit operator the predictor
+solved: SIMPLE's d = V / a_P, OpenFOAM's rAU), D G phi = D F* / c with the nine-point face gradient (a constant
+matrix, factorised once), F = F* - c G phi on the faces, u = u* - c grad phi at the centres (Green-Gauss, the
+boundary faces' values extrapolated along the grid lines), p += phi, c = dt over BDF2's leading coefficient.  Why
+that weight: in the thin wall cells the implicit diffusion makes A_P a hundred or more, so the predictor took out
+only c / A_P times the cell gradient; put back with c, the surplus entered the faces' fluxes, and at a sharp
+convex corner, where the two wall cells' normal gradients meet across one face, it pumped a spurious loop of
+several U through the first rings, growing with the step and setting it (the Great Belt's nose).  The step: each
+cell's explicit rates added (the convective Courant number of its explicit faces, the cross terms of skewed
+cells), the fastest cell's.
 
 The outer boundary's velocity (two rings of ghost cells) and face fluxes come from an ``outer`` provider:
 :class:`Farfield` (a uniform stream), or the Cartesian background of an overset pair.

@@ -51,6 +51,8 @@ def test_each_outline_changes_one_dimension_and_its_v_c_is_compared_with_the_ass
 
 @pytest.mark.parametrize("args, message", [(["--change", "keel_depth=1"], "--change"),
                                            (["--change", "chord_m=30"], "--change"),
+                                           (["--change", "railing_height_m=2"], "--change"),
+                                           (["--change", "cross_fall=0", "cross_fall=0.01"], "twice"),
                                            (["--change", "cross_fall=steep"], "--change"),
                                            (["--change", "cross_fall=0.9"], "cross_fall")])
 def test_bad_input_names_the_field_and_writes_nothing(tmp_path, monkeypatch, capsys, args, message):
@@ -80,3 +82,13 @@ def test_an_outline_that_cannot_be_computed_is_said_and_the_others_are_kept(tmp_
     bad = [r for r in rows if r.get("error")]
     assert [r["change"] for r in bad] == ["cross_fall 0.02 -> 0"] and "cannot be meshed" in bad[0]["error"]
     assert all(r["flutter.critical_speed_m_s"] is not None for r in rows if not r.get("error"))
+
+
+def test_a_scenario_without_cfd_aerodynamics_is_refused(tmp_path, monkeypatch, capsys):
+    """With thin-plate aerodynamics the outline changes nothing: every row would show the same V_c."""
+    tool = load_tool("outline_sensitivity")
+    calls = []
+    monkeypatch.setattr(tool, "run_stages", _fake_run(calls))
+    out = tmp_path / "s.json"
+    assert tool.main(["thin_plate_section", "--out", str(out)]) == 2
+    assert "cfd" in capsys.readouterr().err and not out.exists() and not calls

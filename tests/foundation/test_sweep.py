@@ -2,6 +2,7 @@
 
 import h5py
 import numpy as np
+import pytest
 
 import bridge.sweep as sweep
 from bridge.sweep import main, plan_cases, run_shared_stages
@@ -81,3 +82,38 @@ def test_the_sweep_runs_the_shared_stages_first_unless_the_cache_is_off(tmp_path
     args = ["great_belt", "--main-span", "1624,2000", "--stages", "cable", "--workers", "1", "--out", str(tmp_path)]
     assert main(args) == 0 and seen == [(2, tmp_path / ".cache")]
     assert main([*args, "--no-cache", "--name", "again"]) == 0 and len(seen) == 1
+
+
+def test_the_cases_read_the_shared_stage_that_ran_once_and_a_resumed_sweep_runs_it_no_more(tmp_path, monkeypatch):
+    """End to end with a stand-in for the aero stage (counted): it runs once for two spans, under the cache key each
+    case then looks up (both say "from the cache: aero"); its error reaches the cases; rerun with every case
+    finished and the cache emptied, nothing is computed again; Ctrl-C in it stops the sweep."""
+    import shutil
+
+    import bridge.pipeline as pipeline
+    from bridge.stages import StageOutput
+    from bridge.sweep import run_sweep
+
+    real, runs, fail = pipeline.resolve_stage, [], []
+
+    def aero(scenario, outputs, options):
+        runs.append(scenario.geometry.main_span_m)
+        if fail:
+            raise fail[0]
+        return StageOutput(summary={"aero.section": "stand-in"}, write_h5=lambda g: None, report="## Aero\n")
+
+    monkeypatch.setattr(pipeline, "resolve_stage", lambda name: aero if name == "aero" else real(name))
+    cases = plan_cases("great_belt_body_fitted", [1624.0, 2000.0], {})
+    said = []
+    status = run_sweep(cases, tmp_path / "s", ["aero"], False, 1, None, said.append, cache_dir=tmp_path / "cache")
+    assert runs == [1624.0], runs
+    assert all(v.startswith("done") and "from the cache: aero" in v for v in status.values()), status
+    shutil.rmtree(tmp_path / "cache")
+    status = run_sweep(cases, tmp_path / "s", ["aero"], False, 1, None, said.append, cache_dir=tmp_path / "cache")
+    assert runs == [1624.0] and set(status.values()) == {"skipped"}
+    fail.append(RuntimeError("no grid"))
+    status = run_sweep(cases, tmp_path / "t", ["aero"], False, 1, None, said.append, cache_dir=tmp_path / "cache")
+    assert all("no grid" in v for v in status.values()) and any("no grid" in m for m in said)
+    fail[0] = KeyboardInterrupt()
+    with pytest.raises(KeyboardInterrupt):
+        run_sweep(cases, tmp_path / "u", ["aero"], False, 1, None, said.append, cache_dir=tmp_path / "cache")
