@@ -165,9 +165,16 @@ def _trust(s: Mapping[str, Any], vc: Any) -> str:
     turbulence = "URANS with k-omega SST" if s.get("aero.turbulence") == "sst" else "laminar Navier-Stokes"
     line = f"aerodynamics: the deck's own, from forced-motion CFD ({turbulence}, preset '{quality}'); {study}"
     lo, hi = s.get("aero.vc_grid_error_low_percent"), s.get("aero.vc_grid_error_high_percent")
-    if isinstance(vc, float) and isinstance(lo, float) and isinstance(hi, float):
-        line += f": grid-converged V_c about {vc / (1 - lo / 100):.0f}-{vc / (1 - hi / 100):.0f} m/s"
-    return line
+    if not (isinstance(vc, float) and isinstance(lo, float) and isinstance(hi, float)):
+        return line
+    from .aero.accuracy import STUDIED_MAIN_SPAN_M
+
+    span = s.get("scenario.main_span_m")
+    if isinstance(span, float) and abs(span - STUDIED_MAIN_SPAN_M) > 0.5:
+        # the V_c error depends on where the bridge flutters, not only on the deck's grid (docs/flutter.md)
+        return line + (f"; that V_c error was measured with the {STUDIED_MAIN_SPAN_M:g} m bridge's modes, not this "
+                       f"{span:g} m one's (Models A-C moved -0.4 to +1.1 % from 16 to 24 cells; docs/flutter.md)")
+    return line + f": grid-converged V_c about {vc / (1 - lo / 100):.0f}-{vc / (1 - hi / 100):.0f} m/s"
 
 
 def _written_by_us(folder: Path) -> set[str]:

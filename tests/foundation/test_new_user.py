@@ -130,6 +130,14 @@ def test_a_cfd_flutter_speed_comes_with_its_grid_error_or_says_it_has_none():
     line = headline({**base, "flutter.critical_speed_m_s": 80.3, "aero.grid_study": text,
                      "aero.vc_grid_error_low_percent": err[0], "aero.vc_grid_error_high_percent": err[1]})[1]
     assert "about 81-83 m/s" in line, line
+    # measured with the Great Belt's modes: another span keeps the record's words but gets no corrected V_c
+    # (the up-scaled bridges' V_c moved -0.4 to +1.1 % from 16 to 24 cells, the Great Belt's +0.6 %)
+    for span, corrected in ((1624.0, True), (3000.0, False)):
+        line = headline({**base, "flutter.critical_speed_m_s": 43.3, "scenario.main_span_m": span,
+                         "aero.grid_study": text, "aero.vc_grid_error_low_percent": err[0],
+                         "aero.vc_grid_error_high_percent": err[1]})[1]
+        assert ("grid-converged V_c about 44-45 m/s" in line) is corrected, line
+        assert ("1624 m bridge's modes, not this 3000 m one's" in line) is not corrected, line
     for quality in ("standard", "fine"):
         text, err = grid_accuracy(deck, body, quality, 1.05e8)
         assert err is None and text.startswith(f"no grid study covers the '{quality}' preset on the body-fitted grid")
