@@ -173,7 +173,8 @@ def _trust(s: Mapping[str, Any], vc: Any) -> str:
     if isinstance(span, float) and abs(span - STUDIED_MAIN_SPAN_M) > 0.5:
         # the V_c error depends on where the bridge flutters, not only on the deck's grid (docs/flutter.md)
         return line + (f"; that V_c error was measured with the {STUDIED_MAIN_SPAN_M:g} m bridge's modes, not this "
-                       f"{span:g} m one's (Models A-C moved -0.4 to +1.1 % from 16 to 24 cells; docs/flutter.md)")
+                       f"{span:g} m one's (how far V_c moves with the grid depends on where a bridge flutters; "
+                       "docs/flutter.md)")
     return line + f": grid-converged V_c about {vc / (1 - lo / 100):.0f}-{vc / (1 - hi / 100):.0f} m/s"
 
 

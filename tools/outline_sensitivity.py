@@ -37,7 +37,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 from bridge.config import load_scenario  # noqa: E402
 from bridge.errors import ConvergenceError, InputError  # noqa: E402
 from bridge.files import atomic_write_text  # noqa: E402
-from bridge.pipeline import run_stages  # noqa: E402
+from bridge.pipeline import run_stages, wants_cfd  # noqa: E402
 from bridge.stages import RunOptions  # noqa: E402
 
 # one plausible alternative for each ASSUMED dimension of the Great Belt box (defaults in brackets): a flat roof
@@ -68,8 +68,6 @@ def _parse_changes(items: list[str]) -> dict[str, float]:
 
 
 def _outline(scenario):
-    from bridge.pipeline import wants_cfd
-
     if not wants_cfd(scenario):
         raise InputError("scenario", scenario.name, "its flutter stage must take the deck's aerodynamics from the "
                          "CFD ([flutter] aerodynamics = \"cfd\"): else the outline changes nothing")

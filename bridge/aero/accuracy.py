@@ -71,6 +71,7 @@ BODY_FITTED_STUDY = {
                         "assumed order of 0.8-2"),
 }
 
+
 @dataclass(frozen=True)
 class _Study:
     """One grid study: its records by preset, the flow model a run must match for them to apply (on the
