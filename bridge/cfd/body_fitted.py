@@ -115,15 +115,19 @@ class OGridLocator:
             X = np.zeros(jf.shape)
             Y = np.zeros(jf.shape)
             Xj, Yj, Xi, Yi = (np.zeros(jf.shape) for _ in range(4))
+            columns = [(i0 + b) % g.ni for b in range(4)]
             for a in range(4):
+                rows = (j0 + a) * g.ni
                 for b in range(4):
-                    xn, yn = g.x[j0 + a, (i0 + b) % g.ni], g.y[j0 + a, (i0 + b) % g.ni]
-                    X += wj[:, a] * wi[:, b] * xn
-                    Y += wj[:, a] * wi[:, b] * yn
-                    Xj += dj[:, a] * wi[:, b] * xn
-                    Yj += dj[:, a] * wi[:, b] * yn
-                    Xi += wj[:, a] * di[:, b] * xn
-                    Yi += wj[:, a] * di[:, b] * yn
+                    node = rows + columns[b]
+                    xn, yn = g.x.ravel()[node], g.y.ravel()[node]
+                    w, w_j, w_i = wj[:, a] * wi[:, b], dj[:, a] * wi[:, b], wj[:, a] * di[:, b]
+                    X += w * xn
+                    Y += w * yn
+                    Xj += w_j * xn
+                    Yj += w_j * yn
+                    Xi += w_i * xn
+                    Yi += w_i * yn
             det = Xi * Yj - Xj * Yi
             rx, ry = px - X, py - Y
             if_ = if_ + (Yj * rx - Xj * ry) / det
@@ -140,13 +144,17 @@ class OGridLocator:
         dx, dy = g.x[j + 1, i], g.y[j + 1, i]
         s = np.full(px.shape, 0.5)
         t = np.full(px.shape, 0.5)
+        ab_x, ab_y, dc_x, dc_y = bx - ax, by - ay, cx - dx, cy - dy
+        ad_x, ad_y, bc_x, bc_y = dx - ax, dy - ay, cx - bx, cy - by
         for _ in range(iterations):
-            X = (1 - s) * (1 - t) * ax + s * (1 - t) * bx + s * t * cx + (1 - s) * t * dx
-            Y = (1 - s) * (1 - t) * ay + s * (1 - t) * by + s * t * cy + (1 - s) * t * dy
-            xs = (1 - t) * (bx - ax) + t * (cx - dx)
-            ys = (1 - t) * (by - ay) + t * (cy - dy)
-            xt = (1 - s) * (dx - ax) + s * (cx - bx)
-            yt = (1 - s) * (dy - ay) + s * (cy - by)
+            s1, t1 = 1 - s, 1 - t
+            wa, wb, wc, wd = s1 * t1, s * t1, s * t, s1 * t
+            X = wa * ax + wb * bx + wc * cx + wd * dx
+            Y = wa * ay + wb * by + wc * cy + wd * dy
+            xs = t1 * ab_x + t * dc_x
+            ys = t1 * ab_y + t * dc_y
+            xt = s1 * ad_x + s * bc_x
+            yt = s1 * ad_y + s * bc_y
             det = xs * yt - xt * ys
             rx, ry = px - X, py - Y
             s = s + (yt * rx - xt * ry) / det

@@ -75,6 +75,14 @@ def first_height_for(reynolds: float, y_plus: float = 1.0, chord: float = 1.0) -
     return y_plus * chord / (reynolds * math.sqrt(cf / 2.0))
 
 
+def _eddy_viscosity(kk, ww, sk, s2, d, nu):
+    """SST's nu_t from k and omega (clipped: kk >= 0, ww > 0) and sk = sqrt(kk): the limiter by F2 and the strain."""
+    c = _C
+    arg2 = np.maximum(2.0 * sk / (c["BETA_STAR"] * ww * d), 500.0 * nu / (d * d * ww))
+    f2 = np.tanh(arg2 ** 2)
+    return c["A1"] * kk / np.maximum(c["A1"] * ww, np.sqrt(s2) * f2)
+
+
 def sst_terms(k, w, s2, grad_kw, d, nu):
     """The SST-2003 coefficients of cells (turbulence.py's equations; the same as
     ``kernels.transport.sst_coefficients``): nu_t, the blending F1, k's source and sink rate, omega's source and
@@ -87,9 +95,7 @@ def sst_terms(k, w, s2, grad_kw, d, nu):
     arg1 = np.minimum(np.maximum(sk / (c["BETA_STAR"] * ww * d), 500.0 * nu / (d * d * ww)),
                       4.0 * c["SIGMA_W2"] * kk / (cd * d * d))
     f1 = np.tanh(arg1 ** 4)
-    arg2 = np.maximum(2.0 * sk / (c["BETA_STAR"] * ww * d), 500.0 * nu / (d * d * ww))
-    f2 = np.tanh(arg2 ** 2)
-    nu_t = c["A1"] * kk / np.maximum(c["A1"] * ww, np.sqrt(s2) * f2)
+    nu_t = _eddy_viscosity(kk, ww, sk, s2, d, nu)
     beta = f1 * c["BETA1"] + (1 - f1) * c["BETA2"]
     gamma = f1 * c["GAMMA1"] + (1 - f1) * c["GAMMA2"]
     cross = 2.0 * (1 - f1) * c["SIGMA_W2"] * grad_kw / ww
@@ -224,10 +230,12 @@ class CurvilinearSST:
         return 2.0 * (ux * ux + vy * vy) + (uy + vx) ** 2
 
     def _hand_on(self, t: float) -> None:
-        """The flow's nu_t from k and omega now: all of :meth:`update` that the flow's next step reads (nu_t does
-        not depend on the cross diffusion, so grad k . grad omega is left out); the rest waits for the next
-        transport, which starts with :meth:`update`."""
-        self.nu_t = sst_terms(self.k, self.omega, self._strain(t), 0.0, self.wall_distance, self.nu)[0]
+        """The flow's nu_t from k and omega now: all of :meth:`update` that the flow's next step reads (nu_t alone:
+        its limiter needs neither F1 nor grad k . grad omega); the rest waits for the next transport, which starts
+        with :meth:`update`."""
+        kk = np.maximum(self.k, 0.0)
+        self.nu_t = _eddy_viscosity(kk, np.maximum(self.omega, 1e-30), np.sqrt(kk), self._strain(t),
+                                    self.wall_distance, self.nu)
         self.flow.set_eddy_viscosity(self.nu_t, self._first_cells(t, self.nu_t))
 
     def _face_diffusivity(self, sigma_1: float, sigma_2: float):

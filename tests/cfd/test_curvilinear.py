@@ -209,3 +209,44 @@ def test_a_settled_flow_is_the_same_whichever_faces_advect_implicitly():
         run(flow, 40.0)
         cds.append(2 * flow.total_force[0])
     assert abs(cds[1] / cds[0] - 1) < 1e-4, cds
+
+
+def test_sbdf2_with_the_cross_terms_explicit_is_stable_at_any_step_below_a_third():
+    """The step rule for the diffusion's cross terms (``CurvilinearFlow._flow_dt``): SBDF2 on y' = -a y + b y, -a
+    implicit and b explicit, (3/2 + a dt) y1 = 2 y0 - y_1 / 2 + b dt (2 y0 - y_1): the roots of its recursion stay
+    in the unit circle for every a dt >= 0 while |b| <= a / 3, and leave it for b = -0.4 a at a long enough step."""
+    def largest_root(a_dt, b_dt):
+        return np.abs(np.roots([1.5 + a_dt, -(2 + 2 * b_dt), 0.5 + b_dt])).max()
+
+    steps = np.logspace(-3, 6, 200)
+    worst = max(largest_root(x, s * x / 3) for x in steps for s in np.linspace(-1, 1, 41))
+    assert worst <= 1 + 1e-9, worst
+    assert max(largest_root(x, -0.4 * x) for x in steps) > 1.05
+
+
+def test_the_step_ignores_cross_terms_the_implicit_diffusion_dominates():
+    """On the Great Belt deck's O-grid at Re 1.05e8 (wall cells 1.2e-7 B high) the cells of the corners' fans
+    have cross terms whose explicit rate alone would set a step of 0.004 B/V, but under a third of their implicit
+    diffusion's (1/2000 at the fastest): at rest, with no advection to limit it, the step is not limited at all;
+    with the cross terms of one cell put past the bound, the step is that cell's at most."""
+    from bridge.aero.presets import section_polygons
+    from bridge.cfd.curvilinear_sst import first_height_for
+    from bridge.cfd.ogrid import o_grid
+    from bridge.cfd.sections import great_belt_section
+
+    outline = section_polygons(great_belt_section())[0].vertices
+    og = o_grid(outline, 66, first_height_for(1.05e8), 1.2, 0.3)
+    flow = CurvilinearFlow(CurvilinearGrid(og.x, og.y), 1 / 1.05e8, Stationary(), Farfield(0.0, 0.0))
+    assert flow.stable_dt() == math.inf
+    g = flow.grid
+    bj = np.abs(g.beta_j * flow.nu_j)
+    bj[0] = 0.0   # the wall face's differences are the wall's own values
+    cross = np.abs(g.beta_i * flow.nu_i) + np.abs(np.roll(g.beta_i * flow.nu_i, -1, axis=1)) + bj[1:] + bj[:-1]
+    every = 1.0 / float((cross / (g.area * flow.fourier)).max())
+    assert every < 0.01
+    j, i = 40, 10                                  # an interior cell: its i-faces' cross terms past the bound
+    implicit = (np.abs(g.alpha_i * flow.nu_i) + np.abs(np.roll(g.alpha_i * flow.nu_i, -1, axis=1))
+                + np.abs(g.alpha_j * flow.nu_j)[1:] + np.abs(g.alpha_j * flow.nu_j)[:-1])
+    g.beta_i[j, i] = g.beta_i[j, i + 1] = implicit[j, i] / (3 * flow.nu_i[j, i])
+    expected = g.area[j, i] * flow.fourier / (2 * implicit[j, i] / 3)
+    assert flow.stable_dt() <= expected * (1 + 1e-12)
