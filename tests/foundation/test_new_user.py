@@ -131,7 +131,7 @@ def test_a_cfd_flutter_speed_comes_with_its_grid_error_or_says_it_has_none():
                      "aero.vc_grid_error_low_percent": err[0], "aero.vc_grid_error_high_percent": err[1]})[1]
     assert "about 81-83 m/s" in line, line
     # measured with the Great Belt's modes: another span keeps the record's words but gets no corrected V_c
-    # (the up-scaled bridges' V_c moved -0.4 to +1.1 % from 16 to 24 cells, the Great Belt's +0.6 %)
+    # (the up-scaled bridges' V_c moved -0.4 to +1.2 % from 16 to 24 cells, the Great Belt's +0.6 %)
     for span, corrected in ((1624.0, True), (3000.0, False)):
         line = headline({**base, "flutter.critical_speed_m_s": 43.3, "scenario.main_span_m": span,
                          "aero.grid_study": text, "aero.vc_grid_error_low_percent": err[0],
