@@ -116,11 +116,12 @@ class OGridLocator:
             Y = np.zeros(jf.shape)
             Xj, Yj, Xi, Yi = (np.zeros(jf.shape) for _ in range(4))
             columns = [(i0 + b) % g.ni for b in range(4)]
+            x_flat, y_flat = g.x.ravel(), g.y.ravel()
             for a in range(4):
                 rows = (j0 + a) * g.ni
                 for b in range(4):
                     node = rows + columns[b]
-                    xn, yn = g.x.ravel()[node], g.y.ravel()[node]
+                    xn, yn = x_flat[node], y_flat[node]
                     w, w_j, w_i = wj[:, a] * wi[:, b], dj[:, a] * wi[:, b], wj[:, a] * di[:, b]
                     X += w * xn
                     Y += w * yn

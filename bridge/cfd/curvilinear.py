@@ -669,29 +669,34 @@ class CurvilinearFlow(FlowBase):
         Fi, Fj = self.Fi, self.Fj
         return float(np.abs(np.roll(Fi, -1, axis=1) - Fi + Fj[1:] - Fj[:-1]).max())
 
+    def diffusion_sums(self) -> tuple[np.ndarray, np.ndarray]:
+        """Each cell's sums over its faces of |beta| Gamma (the explicit cross terms) and of |alpha| Gamma (the
+        implicit diffusion), the momentum's Gamma = nu_i, nu_j; the wall face's cross term none (its differences
+        are the wall's own values, given).  Over the cell's area, the rates that :meth:`_flow_dt` weighs."""
+        g = self.grid
+        bi, bj = np.abs(g.beta_i * self.nu_i), np.abs(g.beta_j * self.nu_j)
+        bj[0] = 0.0
+        ai, aj = np.abs(g.alpha_i * self.nu_i), np.abs(g.alpha_j * self.nu_j)
+        return (bi + np.roll(bi, -1, axis=1) + bj[1:] + bj[:-1]), (ai + np.roll(ai, -1, axis=1) + aj[1:] + aj[:-1])
+
     def _flow_dt(self) -> float:
         g = self.grid
         t = self.t
         Fi_rel, Fj_rel = self.relative_fluxes(t)
         Fi_rel, Fj_rel = np.abs(Fi_rel), np.where(g.implicit_j, 0.0, np.abs(Fj_rel))
         rate = (Fi_rel + np.roll(Fi_rel, -1, axis=1) + Fj_rel[1:] + Fj_rel[:-1]) / (2 * g.area)
-        # the explicit cross-derivative diffusion (skewed cells only); the wall face's differences the wall's own
-        # values, given (at a corner's fan its beta is large).  SBDF2 with the diffusion's alpha terms implicit
-        # (rate a) and the cross terms explicit (rate b) is stable at any step while |b| <= a / 3 (the test
-        # equation y' = (-a + b) y: the roots of its recursion stay in the unit circle; Frank, Hundsdorfer and
-        # Verwer 1997, Appl. Numer. Math. 25).  For the operators the bound is on the eigenvalues of
-        # (-L_alpha)^-1 C, which a cell's sums only indicate: a mode along the wall feels less of the implicit
-        # diffusion across the rings than the cell's sum holds.  So a per-cell rule, checked on the operators of
-        # the Great Belt deck's O-grid (0.13 there, under 1/3: tests/cfd/test_curvilinear.py): a cell counts its
-        # cross terms only where they exceed a third of its implicit diffusion (in the wall cells at the deck's
-        # corners, counted, they set a step 6 times the background's shorter); each cell's two explicit rates
-        # add, and the fastest cell sets the step
-        bj = np.abs(g.beta_j * self.nu_j)
-        bj[0] = 0.0
-        bi = np.abs(g.beta_i * self.nu_i)
-        cross = bi + np.roll(bi, -1, axis=1) + bj[1:] + bj[:-1]
-        ai, aj = np.abs(g.alpha_i * self.nu_i), np.abs(g.alpha_j * self.nu_j)
-        cross = np.where(3.0 * cross > ai + np.roll(ai, -1, axis=1) + aj[1:] + aj[:-1], cross, 0.0)
+        # the explicit cross-derivative diffusion (skewed cells only; at a corner's fan its beta is large).  SBDF2
+        # with the diffusion's alpha terms implicit (rate a) and the cross terms explicit (rate b) is stable at any
+        # step while |b| <= a / 3 (the test equation y' = (-a + b) y: the roots of its recursion stay in the unit
+        # circle; Frank, Hundsdorfer and Verwer 1997, Appl. Numer. Math. 25).  For the operators the bound is on
+        # the eigenvalues of (-L_alpha)^-1 C, which a cell's sums only indicate: a mode along the wall feels less of
+        # the implicit diffusion across the rings than the cell's sum holds.  So a per-cell rule, checked on the
+        # operators of the Great Belt deck's O-grid (0.13 there, under 1/3: tests/cfd/test_curvilinear.py): a cell
+        # counts its cross terms only where they exceed a third of its implicit diffusion (in the wall cells at the
+        # deck's corners, counted, they set a step 6 times the background's shorter); each cell's two explicit
+        # rates add, and the fastest cell sets the step
+        cross, implicit = self.diffusion_sums()
+        cross = np.where(3.0 * cross > implicit, cross, 0.0)
         fastest = float((rate / self.cfl + cross / (g.area * self.fourier)).max())
         return 1.0 / fastest if fastest != 0 else math.inf   # (a NaN state stays NaN)
 
