@@ -175,7 +175,8 @@ def _trust(s: Mapping[str, Any], vc: Any) -> str:
         return line + (f"; that V_c error was measured with the {STUDIED_MAIN_SPAN_M:g} m bridge's modes, not this "
                        f"{span:g} m one's (how far V_c moves with the grid depends on where a bridge flutters; "
                        "docs/flutter.md)")
-    return line + f": grid-converged V_c about {vc / (1 - lo / 100):.0f}-{vc / (1 - hi / 100):.0f} m/s"
+    low, high = f"{vc / (1 - lo / 100):.0f}", f"{vc / (1 - hi / 100):.0f}"
+    return line + f": grid-converged V_c about {low if low == high else f'{low}-{high}'} m/s"
 
 
 def _written_by_us(folder: Path) -> set[str]:

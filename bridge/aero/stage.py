@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from bridge.aero.accuracy import grid_accuracy
+from bridge.aero.accuracy import GridRecord, grid_accuracy
 from bridge.aero.forced_motion import ForcedCase, StaticCase, checkpoint_path, run_cases, whole_periods
 from bridge.aero.frequency_response import distortion, forced_motion_response
 from bridge.aero.options import AeroOptions
@@ -37,7 +37,7 @@ from bridge.flutter.tables import DerivativeTable
 from bridge.results import write_dataset
 from bridge.stages import RunOptions, StageOutput
 
-__all__ = ["run", "AeroResult", "scenario_preset"]
+__all__ = ["run", "AeroResult", "scenario_preset", "write_aero_h5", "aero_report", "write_static_h5", "static_report"]
 
 
 @dataclass(frozen=True)
@@ -64,6 +64,7 @@ class AeroResult:
     grid_study: str = ""               # the preset's grid error as measured (bridge.aero.accuracy), or "none"
     vc_grid_error_percent: tuple[float, float] | None = None   # V_c below the grid-converged one (low, high) %
     cells_per_chord: int = 0           # the body grid's cells per chord (the preset's, or [aero] cells_per_chord)
+    grid_record: GridRecord | None = None   # the study's record of the preset, where one covers the run
 
     @property
     def reduced_velocity(self) -> np.ndarray:
@@ -162,12 +163,12 @@ def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
     tilt = f", about {aopts.mean_angle_deg:g} deg" if aopts.mean_angle_deg else ""
     table.name = f"cfd ({section.name}, {quality}, Re {q.physics.reynolds:.3g}{sst}{tilt})"
     model = table if static is None else WithLateral(table, static.quasi_steady())
-    study, vc_error = grid_accuracy(section, aopts, quality, q.physics.reynolds)
+    study, vc_error, record = grid_accuracy(section, aopts, quality, q.physics.reynolds)
     data = AeroResult(section.describe(), quality, q.physics.reynolds, cells, Ks, frf, stderr, model,
                       tuple(records), warning, static, tuple(static_records), aopts.grid, grids, q.physics.turbulence,
                       q.physics.sst_walls,
-                      study, vc_error, q.grid.cells_per_chord)
-    return StageOutput(summary=_summary(data), write_h5=lambda g: _write_h5(g, data), report=_report(data),
+                      study, vc_error, q.grid.cells_per_chord, record)
+    return StageOutput(summary=_summary(data), write_h5=lambda g: write_aero_h5(g, data), report=aero_report(data),
                        figures=_figures(data), data=data)
 
 
@@ -281,7 +282,7 @@ def _summary(d: AeroResult) -> dict[str, Any]:
     return s
 
 
-def _write_h5(group: Any, d: AeroResult) -> None:
+def write_aero_h5(group: Any, d: AeroResult) -> None:
     """Fill ``results.h5:/aero`` (docs/results.md, section ``/aero``)."""
     n = d.reduced_frequency.size
     group.attrs["section"] = d.section
@@ -306,6 +307,18 @@ def _write_h5(group: Any, d: AeroResult) -> None:
                           f"({n},) Scanlan's {name}* (B form, h and L down, alpha and M nose-up)")
     if d.static is not None:
         write_static_h5(group.create_group("static"), d.static)
+    r = d.grid_record
+    if r is not None and r.derivative_change:
+        g = group.create_group("grid_study")
+        g.attrs["finest_cells_per_chord"] = r.finest_cells
+        g.attrs["basis"] = r.basis
+        m = len(r.reduced_velocities)
+        write_dataset(g, "reduced_velocity", np.array(r.reduced_velocities), "1",
+                      f"({m},) U / (f B) of the grid study (bridge/aero/accuracy.py)")
+        for name, change in r.derivative_change:
+            write_dataset(g, name, np.array(change), "1",
+                          f"({m},) {name}* on the study's finest grid over this preset's, less 1 (the preset's "
+                          "grid error of the derivative, measured on this deck)")
 
 
 def write_static_h5(g: Any, st: StaticCoefficients) -> None:
@@ -337,7 +350,15 @@ def values_of(d: AeroResult) -> tuple[str, ...]:
     return tuple(n for n in VERTICAL_TORSIONAL + ("h_qu", "h_qtheta") if np.any(getattr(d.frf, n)))
 
 
-def _report(d: AeroResult) -> str:
+def _change(c: float) -> str:
+    """A derivative's relative change in words: per cent, a factor where it grows more than tenfold (a derivative
+    near zero on the coarser grid), or its sign turning."""
+    if c <= -1.0:
+        return "sign turns"
+    return f"x {1.0 + c:.0f}" if c > 9.0 else f"{100 * c:+.0f} %"
+
+
+def aero_report(d: AeroResult) -> str:
     from bridge.flutter.aerodynamics import Theodorsen
 
     theo = derivatives_from_frf(d.reduced_frequency, Theodorsen().frf(d.reduced_frequency, 1.0))
@@ -352,6 +373,15 @@ def _report(d: AeroResult) -> str:
              "periods dropped, a least-squares harmonic fit over the whole periods left (docs/aero.md).", ""]
     if d.grid_study:
         lines += [f"Accuracy: {d.grid_study}.", ""]
+    r = d.grid_record
+    if r is not None and r.derivative_change:
+        lines += [f"Each derivative's change from this preset's grid to {r.finest_cells} cells per chord, as the grid "
+                  "study measured it:", "",
+                  "| U/(fB) | " + " | ".join(f"{n}*" for n, _ in r.derivative_change) + " |",
+                  "|---|" + "---|" * len(r.derivative_change)]
+        for k, u in enumerate(r.reduced_velocities):
+            lines.append(f"| {u:.4g} | " + " | ".join(_change(c[k]) for _, c in r.derivative_change) + " |")
+        lines.append("")
     if d.warning:
         lines += [f"**Warning: {d.warning}.**", ""]
     lines += ["| U/(fB) | H1* | H1* Theodorsen | H3* | H3* Theodorsen | A1* | A1* Theodorsen | A2* "

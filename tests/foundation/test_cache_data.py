@@ -288,6 +288,34 @@ def test_the_aero_result_and_the_aerodynamic_tables_read_back_as_they_were():
     same(table, round_trip(table), "table")
 
 
+def test_the_aero_result_keeps_the_grid_studys_change_of_each_derivative(tmp_path):
+    """A run that a grid study covers carries the study's record: it reads back from the cache as it was, and
+    results.h5:/aero/grid_study and the report give each derivative's change to the study's finest grid."""
+    from dataclasses import replace
+
+    from bridge.aero.accuracy import GridRecord
+    from bridge.aero.stage import aero_report, write_aero_h5
+
+    record = GridRecord("quick", (1.0, 2.0), "words", "how", 32, (8.0, 20.0),
+                        (("H1", (0.02, -0.01)), ("A2", (0.05, -1.5))))
+    aero = replace(small_aero_result(), grid_record=record)
+    same(aero, round_trip(aero), "aero")
+    aero = replace(aero, records=({**aero.records[0], "periods": 2},))   # as the stage's runs record them
+    with h5py.File(tmp_path / "r.h5", "w") as h5:
+        write_aero_h5(h5.create_group("aero"), aero)
+    with h5py.File(tmp_path / "r.h5", "r") as h5:
+        g = h5["aero/grid_study"]
+        assert g.attrs["finest_cells_per_chord"] == 32 and g.attrs["basis"] == "how"
+        np.testing.assert_array_equal(g["reduced_velocity"][:], [8.0, 20.0])
+        np.testing.assert_array_equal(g["A2"][:], [0.05, -1.5])
+        assert set(g) == {"reduced_velocity", "H1", "A2"} and g["H1"].attrs["unit"] == "1"
+    text = aero_report(aero)
+    assert "| U/(fB) | H1* | A2* |" in text and "| 20 | -1 % | sign turns |" in text, text
+    with h5py.File(tmp_path / "none.h5", "w") as h5:   # no record (or one without a table): no group
+        write_aero_h5(h5.create_group("aero"), small_aero_result())
+        assert "grid_study" not in h5["aero"]
+
+
 @pytest.mark.slow  # ~90 s: the aero stage's CFD on the "tiny" preset (one process)
 def test_the_real_aero_stage_result_reads_back_as_it_was(tmp_path):
     from bridge import cache
