@@ -14,11 +14,11 @@ number, reduced velocities and bridge.  Printed, and written to ``--out`` (defau
 * the flutter speed of every grid (the governing pair's, and each pair's that flutters on every grid) and,
   with three grids, Roache's grid convergence index with Celik et al.'s observed order for unequal refinement
   ratios (:func:`bridge.aero.accuracy.three_grids`): the order, the extrapolated V_c, the finest grid's
-  index and how far the coarsest grid's V_c lies from the extrapolation.
+  index and how far the coarsest grid's V_c lies from the extrapolation; for a sequence that oscillates or
+  does not converge, no order, only how far apart the three lie.
 
-What it cannot tell: an order from three grids is a measurement of those grids only, and an oscillating or
-diverging sequence gives none (it says so).  The governing pair may change between grids; the per-pair
-speeds show whether it does.
+What it cannot tell: an order from three grids is a measurement of those grids only.  The governing pair may
+change between grids; the per-pair speeds show whether it does.
 """
 
 from __future__ import annotations
@@ -99,7 +99,7 @@ def _three(values, cells) -> dict | None:
         return None
     g = three_grids(values, cells)
     return {"order": g.order, "extrapolated": g.extrapolated, "gci_fine": g.gci_fine, "monotone": g.monotone,
-            "converging": g.converging, "coarsest_off_extrapolated": g.off_extrapolated(2)}
+            "converging": g.converging, "spread": g.spread, "coarsest_off_extrapolated": g.off_extrapolated(2)}
 
 
 def analyse(runs: list[dict]) -> dict:
@@ -163,11 +163,12 @@ def report(result: dict) -> str:
         if t is None:
             lines.append(f"{label}: {vals}")
         elif not math.isfinite(t["order"]):
-            why = "the changes do not shrink" if not t["converging"] else "a change is zero"
-            lines.append(f"{label}: {vals}; no observed order ({why}{'' if t['monotone'] else ', oscillating'})")
+            why = ("not monotone" if not t["monotone"] else "the changes do not shrink" if not t["converging"]
+                   else "a change is zero")
+            lines.append(f"{label}: {vals}; no observed order ({why}); the three lie within "
+                         f"{100 * t['spread']:.1f} % of the finest")
         else:
-            lines.append(f"{label}: {vals}; observed order {t['order']:.2f}"
-                         f"{'' if t['monotone'] else ' (oscillating: not to be trusted)'}, extrapolated "
+            lines.append(f"{label}: {vals}; observed order {t['order']:.2f}, extrapolated "
                          f"{t['extrapolated']:.2f}, GCI of the finest {100 * t['gci_fine']:.1f} %, the coarsest "
                          f"{_pct(t['coarsest_off_extrapolated'])} from the extrapolation")
     return "\n".join(lines)

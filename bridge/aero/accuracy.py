@@ -147,11 +147,11 @@ def grid_accuracy(section, aero_options, quality: str, reynolds: float
 # ------------------------------------------------------------------------------------------- three grids
 @dataclass(frozen=True)
 class ThreeGrids:
-    """What three grids say of one result (:func:`three_grids`): the observed order ``order`` (NaN where the
-    changes do not shrink, or one is zero), the extrapolated value ``extrapolated``, the finest grid's grid
-    convergence index ``gci_fine`` (a fraction of its value), ``monotone`` (False: the changes alternate in
-    sign, an oscillating sequence whose order and extrapolation mean little) and ``converging`` (the change
-    between the two finest smaller than between the two coarsest)."""
+    """What three grids say of one result (:func:`three_grids`): the observed order ``order``, the extrapolated
+    value ``extrapolated`` and the finest grid's grid convergence index ``gci_fine`` (a fraction of its value),
+    all NaN unless the sequence is ``monotone`` (the two changes of one sign) and ``converging`` (the change
+    between the two finest the smaller); ``spread`` is the largest difference between the three over the finest
+    value's magnitude, the measure left for an oscillating sequence."""
 
     values: tuple[float, float, float]     # finest first
     cells: tuple[float, float, float]      # cells per length, finest first
@@ -160,6 +160,7 @@ class ThreeGrids:
     gci_fine: float
     monotone: bool
     converging: bool
+    spread: float
 
     def off_extrapolated(self, k: int) -> float:
         """Grid k's (0 the finest) relative distance from the extrapolated value, (value - extrapolated) /
@@ -178,7 +179,9 @@ def three_grids(values, cells, safety: float = 1.25, iterations: int = 100) -> T
     order solves  p = |ln|e32 / e21| + ln((r21^p - s) / (r32^p - s))| / ln r21  (fixed-point iteration from
     p = ln|e32 / e21| / ln r21); then phi_ext = (r21^p phi1 - phi2) / (r21^p - 1) and
     GCI_fine = safety |(phi1 - phi2) / phi1| / (r21^p - 1), safety 1.25 for three grids.  Where the changes do
-    not shrink (|e21| >= |e32|) or one is zero the order is NaN, and so are the extrapolation and the index."""
+    not shrink (|e21| >= |e32|), one is zero or they alternate in sign (s < 0: Celik et al.'s formula still
+    returns a number, but an oscillating sequence has no asymptotic order to measure) the order is NaN, and so
+    are the extrapolation and the index."""
     phi = tuple(float(v) for v in values)
     n = tuple(float(c) for c in cells)
     if len(phi) != 3 or len(n) != 3:
@@ -191,10 +194,11 @@ def three_grids(values, cells, safety: float = 1.25, iterations: int = 100) -> T
     e21, e32 = phi[1] - phi[0], phi[2] - phi[1]
     monotone = e21 * e32 >= 0.0
     converging = abs(e21) < abs(e32)
+    spread = (max(phi) - min(phi)) / abs(phi[0]) if phi[0] else math.nan
     nan = math.nan
-    if e21 == 0.0 or e32 == 0.0 or not converging:
-        return ThreeGrids(phi, n, nan, nan, nan, monotone, converging)
-    s = 1.0 if monotone else -1.0
+    if e21 == 0.0 or e32 == 0.0 or not (converging and monotone):
+        return ThreeGrids(phi, n, nan, nan, nan, monotone, converging, spread)
+    s = 1.0
     ratio = abs(e32 / e21)
     p = math.log(ratio) / math.log(r21)
     for _ in range(iterations):
@@ -207,4 +211,4 @@ def three_grids(values, cells, safety: float = 1.25, iterations: int = 100) -> T
     f = r21 ** p
     extrapolated = (f * phi[0] - phi[1]) / (f - 1.0)
     gci = safety * abs(e21 / phi[0]) / (f - 1.0) if phi[0] else nan
-    return ThreeGrids(phi, n, p, extrapolated, gci, monotone, converging)
+    return ThreeGrids(phi, n, p, extrapolated, gci, monotone, converging, spread)

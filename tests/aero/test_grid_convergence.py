@@ -44,8 +44,9 @@ def test_three_grids_against_celik_et_al_2008_table_1():
 def test_three_grids_says_when_the_grids_do_not_converge():
     diverging = three_grids((1.0, 1.2, 1.25), (32, 24, 16))   # the finer change is the larger
     assert not diverging.converging and math.isnan(diverging.order) and math.isnan(diverging.extrapolated)
-    oscillating = three_grids((1.0, 1.05, 0.9), (32, 24, 16))
-    assert not oscillating.monotone and oscillating.converging
+    oscillating = three_grids((1.0, 1.05, 0.9), (32, 24, 16))   # no order: only how far apart the three lie
+    assert not oscillating.monotone and oscillating.converging and math.isnan(oscillating.order)
+    assert oscillating.spread == pytest.approx(0.15)
     flat = three_grids((1.0, 1.0, 1.1), (32, 24, 16))
     assert math.isnan(flat.order)
     for values, cells in (((1, 2), (3, 2, 1)), ((1, 2, 3), (16, 24, 32)), ((1, math.nan, 2), (3, 2, 1))):
