@@ -39,9 +39,11 @@ from bridge.files import atomic_write_text  # noqa: E402
 
 DERIVATIVES = ("H1", "H2", "H3", "H4", "A1", "A2", "A3", "A4")
 SIGN_WATCHED = ("H2", "H4")   # small derivatives whose sign the grid may turn (docs/aero.md)
-# the summary keys that must agree between the runs: only the grid may differ
+# the summary keys that must agree between the runs (and every fem.frequency_* key: the same bridge's modes):
+# only the grid may differ
 SAME = ("aero.section", "aero.quality", "aero.reynolds", "aero.turbulence", "aero.sst_walls", "aero.grid",
-        "aero.reduced_velocity_min", "aero.reduced_velocity_max", "flutter.aerodynamics_option")
+        "aero.reduced_velocity_min", "aero.reduced_velocity_max", "flutter.aerodynamics_option",
+        "scenario.main_span_m")
 
 
 class BadInput(Exception):
@@ -55,14 +57,18 @@ def read_run(folder: Path) -> dict:
         if not f.is_file():
             raise BadInput(f"{folder}: no {f.name} (a run's output folder is needed: python -m bridge.scenario "
                            "writes OUT/<name>/)")
-    summary = json.loads(js.read_text())
-    if "aero.cells_per_chord" not in summary:
+    try:
+        summary = json.loads(js.read_text())
+    except (OSError, ValueError) as err:
+        raise BadInput(f"{js}: not a summary this program wrote ({err})") from None
+    if not isinstance(summary, dict) or not isinstance(summary.get("aero.cells_per_chord"), (int, float)):
         raise BadInput(f"{folder}: the run has no CFD aero stage (no aero.cells_per_chord in summary.json)")
-    with h5py.File(h5, "r") as f:
-        if "aero/derivatives" not in f:
-            raise BadInput(f"{folder}/results.h5: no aero/derivatives group")
-        U = f["aero/reduced_velocity"][:]
-        deriv = {n: f[f"aero/derivatives/{n}"][:] for n in DERIVATIVES}
+    try:
+        with h5py.File(h5, "r") as f:
+            U = f["aero/reduced_velocity"][:]
+            deriv = {n: f[f"aero/derivatives/{n}"][:] for n in DERIVATIVES}
+    except (OSError, KeyError) as err:
+        raise BadInput(f"{h5}: no aero/reduced_velocity or aero/derivatives/H1 ... A4 ({err})") from None
     order = np.argsort(U)
     pairs = {k[len("flutter.pair_"):-len(".critical_speed_m_s")]: v for k, v in summary.items()
              if k.startswith("flutter.pair_") and k.endswith(".critical_speed_m_s") and "lateral" not in k}
@@ -71,7 +77,7 @@ def read_run(folder: Path) -> dict:
             "derivatives": {n: v[order] for n, v in deriv.items()},
             "vc": summary.get("flutter.critical_speed_m_s"), "fc": summary.get("flutter.frequency_hz"),
             "pair": summary.get("flutter.mode_pair"), "pairs": pairs,
-            "same": {k: summary.get(k) for k in SAME}}
+            "same": {k: v for k, v in summary.items() if k in SAME or k.startswith("fem.frequency_")}}
 
 
 def check_runs(runs: list[dict]) -> None:
@@ -80,10 +86,12 @@ def check_runs(runs: list[dict]) -> None:
         raise BadInput(f"the runs' grids must differ: cells per chord {cells}")
     first = runs[0]
     for r in runs[1:]:
-        for k in SAME:
-            if r["same"][k] != first["same"][k]:
-                raise BadInput(f"{r['folder']}: {k} = {r['same'][k]!r}, but {first['folder']} has "
-                               f"{first['same'][k]!r}; only the grid (aero.cells_per_chord) may differ")
+        for k in sorted(set(first["same"]) | set(r["same"])):
+            a, b = first["same"].get(k), r["same"].get(k)
+            same = (math.isclose(a, b, rel_tol=1e-9) if isinstance(a, float) and isinstance(b, float) else a == b)
+            if not same:
+                raise BadInput(f"{r['folder']}: {k} = {b!r}, but {first['folder']} has {a!r}; only the grid "
+                               "(aero.cells_per_chord) may differ")
         if r["U"].shape != first["U"].shape or not np.allclose(r["U"], first["U"], rtol=1e-9):
             raise BadInput(f"{r['folder']}: reduced velocities {r['U'].tolist()}, {first['folder']}: "
                            f"{first['U'].tolist()}; the runs must share them")

@@ -317,8 +317,8 @@ def write_aero_h5(group: Any, d: AeroResult) -> None:
                       f"({m},) U / (f B) of the grid study (bridge/aero/accuracy.py)")
         for name, change in r.derivative_change:
             write_dataset(g, name, np.array(change), "1",
-                          f"({m},) {name}* on the study's finest grid over this preset's, less 1 (the preset's "
-                          "grid error of the derivative, measured on this deck)")
+                          f"({m},) {name}* on the study's finest grid over this preset's, less 1 (how far it moves "
+                          "from the preset's grid to the finest studied, on this deck; not converged there either)")
 
 
 def write_static_h5(g: Any, st: StaticCoefficients) -> None:
