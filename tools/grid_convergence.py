@@ -176,7 +176,8 @@ def report(result: dict) -> str:
             lines.append(f"{label}: {vals}; no observed order ({why}); the three lie within "
                          f"{100 * t['spread']:.1f} % of the finest")
         else:
-            lines.append(f"{label}: {vals}; observed order {t['order']:.2f}, extrapolated "
+            low = " (an order below 0.5: the extrapolation means little)" if t["order"] < 0.5 else ""
+            lines.append(f"{label}: {vals}; observed order {t['order']:.2f}{low}, extrapolated "
                          f"{t['extrapolated']:.2f}, GCI of the finest {100 * t['gci_fine']:.1f} %, the coarsest "
                          f"{_pct(t['coarsest_off_extrapolated'])} from the extrapolation")
     return "\n".join(lines)

@@ -115,6 +115,9 @@ def test_the_tool_reports_the_derivatives_and_v_c_of_three_runs(tmp_path, _tool)
     assert row["change_finest"] == pytest.approx((1 + 1 / 32 ** 2) / (1 + 1 / 24 ** 2) - 1, rel=1e-9)
     assert row["order"] == pytest.approx(2.0, rel=1e-6) and row["signs_kept"]
     assert "observed order 2.00, extrapolated 80.00" in r.stdout
+    slow = [_run_folder(tmp_path, f"slow{n}", n, 1.0, 80.0 - 20.0 / n ** 0.3) for n in (16, 24, 32)]
+    r = _tool(*slow, "--out", tmp_path / "slow.json")
+    assert "observed order 0.30 (an order below 0.5: the extrapolation means little)" in r.stdout, r.stdout
 
 
 def test_the_tool_gives_no_order_where_the_flutter_speed_oscillates(tmp_path, _tool):
