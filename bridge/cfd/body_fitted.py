@@ -357,6 +357,7 @@ class BodyFittedPair(RigidPair, FlowBase):
         self.j_hole = hole_ring(ogrid, h, self.overlap, ring_overlap)
         self._hole_path = _Path(np.column_stack([ogrid.x[self.j_hole], ogrid.y[self.j_hole]]))
         self._body_path = _Path(np.column_stack([ogrid.x[0], ogrid.y[0]]))
+        self._hole_cache = None
         self._hole_hook = _HoleFaces(self)
         self.background.hooks.append(self._hole_hook)
         self._psi_hist: list[tuple[float, np.ndarray]] = []
@@ -396,11 +397,14 @@ class BodyFittedPair(RigidPair, FlowBase):
         ub, vb, om = self.body.frame_velocity(t)
         return ub * eta - vb * xi - 0.5 * om * (xi * xi + eta * eta)
 
-    def hole_targets(self, t_new: float):
-        """Background faces inside the hole at t_new with their velocity targets, as storage indices
-        ((J_u, I_u, u), (J_v, I_v, v)); None if none."""
-        g, grid = GHOST, self.background.grid
-        og = self.body.grid
+    def _hole_geometry(self, t_new: float):
+        """Which background faces lie in the hole at t_new and where their nodes fall in the O-grid; None if none.
+        Kept while the body's pose stays the same (a held section: every step), since the donor search is a
+        sixth of a held cylinder's step."""
+        pose = tuple(float(p) for p in self.motion.pose(t_new))
+        if self._hole_cache is not None and self._hole_cache[0] == pose:
+            return self._hole_cache[1]
+        grid, og = self.background.grid, self.body.grid
         X, Y = self.to_background(og.x[self.j_hole], og.y[self.j_hole], t_new)
         i0 = max(int(np.floor((X.min() - grid.x_faces[0]) / grid.dx)), 1)
         i1 = min(int(np.ceil((X.max() - grid.x_faces[0]) / grid.dx)), grid.nx - 1)
@@ -410,26 +414,40 @@ class BodyFittedPair(RigidPair, FlowBase):
         xi, eta = self.to_body(XC, YC, t_new)
         pts = np.column_stack([xi.ravel(), eta.ravel()])
         inside = self._hole_path.contains_points(pts).reshape(xi.shape)
-        if not inside.any():
+        geom = None
+        if inside.any():
+            solid = self._body_path.contains_points(pts).reshape(xi.shape) & inside
+            fluid = inside & ~solid
+            jf, if_ = self.locator.locate(xi[fluid], eta[fluid])
+            ok = np.isfinite(jf)
+            geom = {"i0": i0, "j0": j0, "j1": j1, "inside": inside, "solid": solid, "fluid": fluid,
+                    "xi": xi, "eta": eta, "jf": jf[ok], "if": if_[ok], "ok": ok,
+                    "u_faces": np.nonzero(inside[:-1, :] & inside[1:, :]),
+                    "v_faces": np.nonzero(inside[:, :-1] & inside[:, 1:])}
+        self._hole_cache = (pose, geom)
+        return geom
+
+    def hole_targets(self, t_new: float):
+        """Background faces inside the hole at t_new with their velocity targets, as storage indices
+        ((J_u, I_u, u), (J_v, I_v, v)); None if none."""
+        geo = self._hole_geometry(t_new)
+        if geo is None:
             return None
-        solid = self._body_path.contains_points(pts).reshape(xi.shape) & inside
-        fluid = inside & ~solid
+        g, grid, og = GHOST, self.background.grid, self.body.grid
+        xi, eta, fluid, solid, ok = geo["xi"], geo["eta"], geo["fluid"], geo["solid"], geo["ok"]
         psi_nodes = self._body_psi(t_new)
-        psi = np.zeros(inside.shape)
-        jf, if_ = self.locator.locate(xi[fluid], eta[fluid])
-        ok = np.isfinite(jf)
-        vals = np.zeros(jf.shape)
-        vals[ok] = self.locator.nodes(psi_nodes, jf[ok], if_[ok])
+        psi = np.zeros(xi.shape)
+        vals = np.zeros(ok.shape)
+        vals[ok] = self.locator.nodes(psi_nodes, geo["jf"], geo["if"])
         # a corner the search did not place (at a cell edge of the wall ring, round-off): the rigid motion's
         rigid_const = float(np.mean(psi_nodes[0] - self._rigid_psi(og.x[0], og.y[0], t_new)))
         vals[~ok] = self._rigid_psi(xi[fluid][~ok], eta[fluid][~ok], t_new) + rigid_const
         psi[fluid] = vals
         psi[solid] = self._rigid_psi(xi[solid], eta[solid], t_new) + rigid_const
+        i0, j0, j1 = geo["i0"], geo["j0"], geo["j1"]
         hy = grid.hy_cells()[g + j0:g + j1]
-        fu = inside[:-1, :] & inside[1:, :]
-        fv = inside[:, :-1] & inside[:, 1:]
-        ju, iu = np.nonzero(fu)
-        jv, iv = np.nonzero(fv)
+        ju, iu = geo["u_faces"]
+        jv, iv = geo["v_faces"]
         tu = (psi[ju + 1, iu] - psi[ju, iu]) / hy[ju]
         tv = -(psi[jv, iv + 1] - psi[jv, iv]) / grid.dx
         return (ju + j0 + g, iu + i0 + g, tu), (jv + j0 + g, iv + i0 + g, tv)

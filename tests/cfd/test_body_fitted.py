@@ -181,3 +181,25 @@ def test_the_hole_keeps_two_background_cells_from_the_wall_and_half_the_rings_of
     assert wall >= 2 * h > distances(graded, j - 1)[0] and outer >= 4 * h
     with pytest.raises(ValueError, match="no hole left"):
         hole_ring(graded, 0.3)
+
+
+def test_the_hole_geometry_is_kept_only_while_the_pose_stays():
+    """BodyFittedPair keeps the hole's faces and donor cells between steps while the body's pose is the same (a
+    held section); a moving body's are found again at each new pose: the targets after an earlier call equal a
+    fresh pair's, and a held body's second call reuses the first's search."""
+    def moving():
+        return PrescribedMotion(lambda t: (0.0, 0.3 * np.sin(t), 0.2 * t))
+
+    used, fresh = _pair(moving()), _pair(moving())
+    used.hole_targets(0.0)
+    for a, b in zip(used.hole_targets(0.7), fresh.hole_targets(0.7), strict=True):
+        for x, y in zip(a, b, strict=True):
+            assert np.array_equal(x, y)
+    held = _pair(Stationary())
+    first = held.hole_targets(0.0)
+    geometry = held._hole_cache[1]
+    second = held.hole_targets(0.5)
+    assert held._hole_cache[1] is geometry
+    for a, b in zip(first, second, strict=True):
+        for x, y in zip(a, b, strict=True):
+            assert np.array_equal(x, y)
