@@ -52,22 +52,27 @@ def write_dataset(group: h5py.Group, name: str, data: Any, unit: str, descriptio
     ds.attrs["description"] = description
 
 
-def _json_value(v: Any) -> Any:
-    """A summary value as strict JSON: NumPy scalars unwrapped, NaN and infinities as null."""
+def json_value(v: Any) -> Any:
+    """A value as strict JSON: NumPy scalars and arrays unwrapped, NaN and infinities (no result) as null,
+    through lists, tuples and dicts."""
     if isinstance(v, (np.bool_, bool)):
         return bool(v)
     if isinstance(v, (np.floating, np.integer)):
         v = v.item()
     if isinstance(v, float) and not math.isfinite(v):
         return None
+    if isinstance(v, np.ndarray):
+        v = v.tolist()
     if isinstance(v, (list, tuple)):
-        return [_json_value(x) for x in v]
+        return [json_value(x) for x in v]
+    if isinstance(v, Mapping):
+        return {k: json_value(x) for k, x in v.items()}
     return v
 
 
 def summary_json(summary: Mapping[str, Any]) -> str:
     """``summary`` as strict JSON text (raises ValueError rather than write NaN or Infinity)."""
-    return json.dumps({k: _json_value(v) for k, v in summary.items()}, indent=2, allow_nan=False) + "\n"
+    return json.dumps(json_value(summary), indent=2, allow_nan=False) + "\n"
 
 
 def _fmt(v: Any, spec: str, unit: str = "") -> str | None:

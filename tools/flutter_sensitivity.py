@@ -39,6 +39,7 @@ from bridge.flutter.determinant import governing, solve_pair  # noqa: E402
 from bridge.flutter.options import FlutterOptions  # noqa: E402
 from bridge.flutter.stage import options_and_aerodynamics  # noqa: E402
 from bridge.pipeline import run_stages  # noqa: E402
+from bridge.results import json_value  # noqa: E402
 from bridge.stages import RunOptions  # noqa: E402
 
 VERTICAL_TORSIONAL = ("H1", "H2", "H3", "H4", "A1", "A2", "A3", "A4")
@@ -93,15 +94,6 @@ def elasticity(factors: list[float], speeds: list[float], base_speed: float) -> 
         return (above[1] - below[1]) / (above[0] - below[0])
     one = below or above
     return one[1] / one[0] if one else math.nan
-
-
-def _finite(x):
-    """NaN (no flutter found) as JSON null."""
-    if isinstance(x, dict):
-        return {k: _finite(v) for k, v in x.items()}
-    if isinstance(x, list):
-        return [_finite(v) for v in x]
-    return None if isinstance(x, float) and not math.isfinite(x) else x
 
 
 def main(argv=None) -> int:
@@ -190,7 +182,7 @@ def _run(args) -> int:
 
     out = args.out or Path("out") / "flutter_sensitivity" / f"{scenario.name}.json"
     out.parent.mkdir(parents=True, exist_ok=True)
-    atomic_write_text(out, json.dumps(_finite({
+    atomic_write_text(out, json.dumps(json_value({
         "scenario": scenario.name, "aerodynamics": aero.name, "air_density_kg_m3": rho,
         "method": "two-mode determinant, every pair of flutter.pairs, without lateral modes",
         "unscaled": {"critical_speed_m_s": v0, "frequency_hz": f0, "pair": pair0},

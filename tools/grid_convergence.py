@@ -36,6 +36,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from bridge.aero.accuracy import three_grids  # noqa: E402
 from bridge.files import atomic_write_text  # noqa: E402
+from bridge.results import json_value  # noqa: E402
 
 DERIVATIVES = ("H1", "H2", "H3", "H4", "A1", "A2", "A3", "A4")
 SIGN_WATCHED = ("H2", "H4")   # small derivatives whose sign the grid may turn (docs/aero.md)
@@ -200,8 +201,7 @@ def main(argv=None) -> int:
     print(report(result))
     out = args.out or Path("out") / "grid_convergence" / f"{runs[0]['name']}.json"
     out.parent.mkdir(parents=True, exist_ok=True)
-    clean = json.loads(json.dumps(result, default=float), parse_constant=lambda c: None)
-    atomic_write_text(out, json.dumps(clean, indent=1, allow_nan=False))
+    atomic_write_text(out, json.dumps(json_value(result), indent=1, allow_nan=False))
     print(f"written {out}")
     return 0
 
