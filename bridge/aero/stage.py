@@ -62,9 +62,8 @@ class AeroResult:
     turbulence: str = "laminar"        # [aero] turbulence: "laminar" or "sst"
     sst_walls: str = "equilibrium"     # [aero] sst_walls: "equilibrium", "function" or "blended" (with "sst")
     grid_study: str = ""               # the preset's grid error as measured (bridge.aero.accuracy), or "none"
-    vc_grid_error_percent: tuple[float, float] | None = None   # V_c below the grid-converged one (low, high) %
     cells_per_chord: int = 0           # the body grid's cells per chord (the preset's, or [aero] cells_per_chord)
-    grid_record: GridRecord | None = None   # the study's record of the preset, where one covers the run
+    grid_record: GridRecord | None = None   # the study's record of the preset (V_c's band), where one covers it
 
     @property
     def reduced_velocity(self) -> np.ndarray:
@@ -163,11 +162,11 @@ def run(scenario: Any, upstream: dict, options: RunOptions) -> StageOutput:
     tilt = f", about {aopts.mean_angle_deg:g} deg" if aopts.mean_angle_deg else ""
     table.name = f"cfd ({section.name}, {quality}, Re {q.physics.reynolds:.3g}{sst}{tilt})"
     model = table if static is None else WithLateral(table, static.quasi_steady())
-    study, vc_error, record = grid_accuracy(section, aopts, quality, q.physics.reynolds)
+    study, _, record = grid_accuracy(section, aopts, quality, q.physics.reynolds)
     data = AeroResult(section.describe(), quality, q.physics.reynolds, cells, Ks, frf, stderr, model,
                       tuple(records), warning, static, tuple(static_records), aopts.grid, grids, q.physics.turbulence,
                       q.physics.sst_walls,
-                      study, vc_error, q.grid.cells_per_chord, record)
+                      study, q.grid.cells_per_chord, record)
     return StageOutput(summary=_summary(data), write_h5=lambda g: write_aero_h5(g, data), report=aero_report(data),
                        figures=_figures(data), data=data)
 
@@ -259,7 +258,7 @@ def _static_results(recs, section, aopts: AeroOptions, options: RunOptions):
 
 
 def _summary(d: AeroResult) -> dict[str, Any]:
-    err = d.vc_grid_error_percent
+    err = None if d.grid_record is None else d.grid_record.vc_low_percent
     s: dict[str, Any] = {"aero.section": d.section, "aero.quality": d.quality, "aero.reynolds": d.reynolds,
                          "aero.turbulence": d.turbulence,
                          **({"aero.sst_walls": d.sst_walls} if d.turbulence == "sst" else {}),
