@@ -55,14 +55,14 @@ def write_dataset(group: h5py.Group, name: str, data: Any, unit: str, descriptio
 def json_value(v: Any) -> Any:
     """A value as strict JSON: NumPy scalars and arrays unwrapped, NaN and infinities (no result) as null,
     through lists, tuples and dicts."""
+    if isinstance(v, np.ndarray):
+        v = v.tolist()
     if isinstance(v, (np.bool_, bool)):
         return bool(v)
     if isinstance(v, (np.floating, np.integer)):
         v = v.item()
     if isinstance(v, float) and not math.isfinite(v):
         return None
-    if isinstance(v, np.ndarray):
-        v = v.tolist()
     if isinstance(v, (list, tuple)):
         return [json_value(x) for x in v]
     if isinstance(v, Mapping):

@@ -255,6 +255,23 @@ def test_summary_json_is_strict_json(tmp_path):
     assert not [k for k, v in s.items() if v == "none"]
 
 
+
+def test_json_value_turns_every_missing_number_into_null_and_unwraps_numpy():
+    """bridge.results.json_value, which the summary and the tools' JSON go through: NaN and infinities as null
+    at any depth (a 0-d array's too), NumPy scalars and arrays as plain values."""
+    import json
+
+    import numpy as np
+
+    from bridge.results import json_value
+
+    v = json_value({"a": np.array(np.nan), "b": (np.array([1.5, np.inf]),), "c": {"d": [np.float32(2.0), np.nan]},
+                    "e": np.bool_(True), "f": np.int64(3)})
+    assert v == {"a": None, "b": [[1.5, None]], "c": {"d": [2.0, None]}, "e": True, "f": 3}
+    assert type(v["f"]) is int and type(v["e"]) is bool
+    json.dumps(v, allow_nan=False)
+
+
 # ------------------------------------------------------------------------------ sweeps
 @pytest.mark.slow  # ~11 s of full pipeline runs: runs in CI with -m slow (default run under 2 min)
 def test_sweep_resumes_only_cases_run_with_the_same_stages(tmp_path):
