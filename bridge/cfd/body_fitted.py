@@ -545,6 +545,7 @@ class BodyFittedSST:
 
         self.pair = pair
         self._ghost_cache = None   # (the time's key, the ghost rings' k and omega then)
+        self._donor_cache = None   # (the body's pose, the hole's cells and their O-grid donors then)
         og = pair.body.grid
         wall = SimpleNamespace(vertices=np.column_stack([og.x[0], og.y[0]]))
         self.background = KOmegaSST(pair.background, k_inf, omega_inf, "resolved",
@@ -581,6 +582,20 @@ class BodyFittedSST:
         solid = pair._body_path.contains_points(pts).reshape(xi.shape)[inside]
         return (JJ[inside] + g, II[inside] + g), xi[inside], eta[inside], solid
 
+    def _hole_donors(self, t: float):
+        """The hole's cells at t (:meth:`hole_cells`) and, for those in the fluid, their places in the O-grid
+        (which of them, donor rows, donor columns); kept while the body's pose stays, as the pair's hole faces."""
+        pose = tuple(float(p) for p in self.pair.motion.pose(t))
+        if self._donor_cache is None or self._donor_cache[0] != pose:
+            (J, I), xi, eta, solid = self.hole_cells(t)
+            donors = (np.zeros(0, dtype=int), np.zeros(0), np.zeros(0))
+            if J.size:
+                jf, if_ = self.pair.locator.locate(xi[~solid], eta[~solid])
+                ok = np.isfinite(jf)
+                donors = (np.nonzero(~solid)[0][ok], jf[ok], if_[ok])
+            self._donor_cache = (pose, (J, I, *donors))
+        return self._donor_cache[1]
+
     def transport_body(self, dt: float) -> None:
         """The O-grid's k and omega over the (sub-)step its flow has just taken."""
         self.body.transport(dt)
@@ -591,14 +606,11 @@ class BodyFittedSST:
         bg, body, t = self.background, self.body, self.pair.t
         self._ghost_cache = None   # the background's k and omega change now
         bg.update()
-        (J, I), xi, eta, solid = self.hole_cells(t)
+        J, I, fluid, jf, if_ = self._hole_donors(t)
         if J.size:
             k, w = np.full(J.size, self.k_inf), np.full(J.size, self.omega_inf)
-            jf, if_ = self.pair.locator.locate(xi[~solid], eta[~solid])
-            ok = np.isfinite(jf)
-            fluid = np.nonzero(~solid)[0][ok]
-            k[fluid] = self.pair.locator.cells(body.k, jf[ok], if_[ok])
-            w[fluid] = self.pair.locator.cells(body.omega, jf[ok], if_[ok])
+            k[fluid] = self.pair.locator.cells(body.k, jf, if_)
+            w[fluid] = self.pair.locator.cells(body.omega, jf, if_)
             bg.hold(J, I, k, w)
         advance_pair(bg.k, bg.omega, dt)
 

@@ -203,3 +203,19 @@ def test_the_hole_geometry_is_kept_only_while_the_pose_stays():
     for a, b in zip(first, second, strict=True):
         for x, y in zip(a, b, strict=True):
             assert np.array_equal(x, y)
+
+
+def test_the_sst_models_hole_donors_are_kept_only_while_the_pose_stays():
+    """BodyFittedSST's background cells in the hole and their O-grid donors, as the pair's hole faces: found again
+    at a moving section's every new pose (equal to a fresh model's), kept for a held one."""
+    from bridge.aero.forced_motion import StaticCase
+
+    q = preset("tiny", "body_fitted").with_(turbulence="sst", reynolds=1e5)
+    polys = section_polygons(FlatPlate(1.0, 0.04))
+    used, fresh = (build_flow(q, polys, ForcedCase.thesis("pitch", 1.0)).turbulence for _ in range(2))
+    used._hole_donors(0.0)
+    for a, b in zip(used._hole_donors(0.7), fresh._hole_donors(0.7), strict=True):
+        assert np.array_equal(a, b)
+    held = build_flow(q, polys, StaticCase(2.0)).turbulence
+    first = held._hole_donors(0.0)
+    assert held._hole_donors(0.5) is first and first[0].size > 0
