@@ -272,6 +272,21 @@ def background_velocity(sim: Simulation, X: np.ndarray, Y: np.ndarray) -> tuple[
     return uu, vv
 
 
+class _WhilePoseStays:
+    """What depends on nothing but the body's pose (which background points lie in the hole, where they fall in
+    the O-grid): computed again only when the pose changes, so a held section searches once (the search was a
+    sixth of a held cylinder's step)."""
+
+    def __init__(self, motion):
+        self.motion, self.pose, self.value = motion, None, None
+
+    def get(self, t: float, compute):
+        pose = tuple(float(p) for p in self.motion.pose(t))
+        if pose != self.pose:
+            self.value, self.pose = compute(t), pose
+        return self.value
+
+
 class _HoleFaces(SubstepHook):
     """Background: the faces inside the hole take the O-grid's velocity (module doc)."""
 
@@ -357,7 +372,7 @@ class BodyFittedPair(RigidPair, FlowBase):
         self.j_hole = hole_ring(ogrid, h, self.overlap, ring_overlap)
         self._hole_path = _Path(np.column_stack([ogrid.x[self.j_hole], ogrid.y[self.j_hole]]))
         self._body_path = _Path(np.column_stack([ogrid.x[0], ogrid.y[0]]))
-        self._hole_cache = None
+        self._hole_cache = _WhilePoseStays(motion)
         self._hole_hook = _HoleFaces(self)
         self.background.hooks.append(self._hole_hook)
         self._psi_hist: list[tuple[float, np.ndarray]] = []
@@ -398,12 +413,8 @@ class BodyFittedPair(RigidPair, FlowBase):
         return ub * eta - vb * xi - 0.5 * om * (xi * xi + eta * eta)
 
     def _hole_geometry(self, t_new: float):
-        """Which background faces lie in the hole at t_new and where their nodes fall in the O-grid; None if none.
-        Kept while the body's pose stays the same (a held section: every step), since the donor search is a
-        sixth of a held cylinder's step."""
-        pose = tuple(float(p) for p in self.motion.pose(t_new))
-        if self._hole_cache is not None and self._hole_cache[0] == pose:
-            return self._hole_cache[1]
+        """Which background faces lie in the hole at t_new, where the fluid ones fall in the O-grid, and the body
+        coordinates of the others (solid, or not placed); None if none."""
         grid, og = self.background.grid, self.body.grid
         X, Y = self.to_background(og.x[self.j_hole], og.y[self.j_hole], t_new)
         i0 = max(int(np.floor((X.min() - grid.x_faces[0]) / grid.dx)), 1)
@@ -414,36 +425,35 @@ class BodyFittedPair(RigidPair, FlowBase):
         xi, eta = self.to_body(XC, YC, t_new)
         pts = np.column_stack([xi.ravel(), eta.ravel()])
         inside = self._hole_path.contains_points(pts).reshape(xi.shape)
-        geom = None
-        if inside.any():
-            solid = self._body_path.contains_points(pts).reshape(xi.shape) & inside
-            fluid = inside & ~solid
-            jf, if_ = self.locator.locate(xi[fluid], eta[fluid])
-            ok = np.isfinite(jf)
-            geom = {"i0": i0, "j0": j0, "j1": j1, "inside": inside, "solid": solid, "fluid": fluid,
-                    "xi": xi, "eta": eta, "jf": jf[ok], "if": if_[ok], "ok": ok,
-                    "u_faces": np.nonzero(inside[:-1, :] & inside[1:, :]),
-                    "v_faces": np.nonzero(inside[:, :-1] & inside[:, 1:])}
-        self._hole_cache = (pose, geom)
-        return geom
+        if not inside.any():
+            return None
+        solid = self._body_path.contains_points(pts).reshape(xi.shape) & inside
+        fluid = inside & ~solid
+        jf, if_ = self.locator.locate(xi[fluid], eta[fluid])
+        ok = np.isfinite(jf)
+        return {"i0": i0, "j0": j0, "j1": j1, "shape": xi.shape, "solid": solid, "fluid": fluid, "ok": ok,
+                "jf": jf[ok], "if": if_[ok], "lost": (xi[fluid][~ok], eta[fluid][~ok]),
+                "in_body": (xi[solid], eta[solid]),
+                "u_faces": np.nonzero(inside[:-1, :] & inside[1:, :]),
+                "v_faces": np.nonzero(inside[:, :-1] & inside[:, 1:])}
 
     def hole_targets(self, t_new: float):
         """Background faces inside the hole at t_new with their velocity targets, as storage indices
         ((J_u, I_u, u), (J_v, I_v, v)); None if none."""
-        geo = self._hole_geometry(t_new)
+        geo = self._hole_cache.get(t_new, self._hole_geometry)
         if geo is None:
             return None
         g, grid, og = GHOST, self.background.grid, self.body.grid
-        xi, eta, fluid, solid, ok = geo["xi"], geo["eta"], geo["fluid"], geo["solid"], geo["ok"]
+        ok = geo["ok"]
         psi_nodes = self._body_psi(t_new)
-        psi = np.zeros(xi.shape)
+        psi = np.zeros(geo["shape"])
         vals = np.zeros(ok.shape)
         vals[ok] = self.locator.nodes(psi_nodes, geo["jf"], geo["if"])
         # a corner the search did not place (at a cell edge of the wall ring, round-off): the rigid motion's
         rigid_const = float(np.mean(psi_nodes[0] - self._rigid_psi(og.x[0], og.y[0], t_new)))
-        vals[~ok] = self._rigid_psi(xi[fluid][~ok], eta[fluid][~ok], t_new) + rigid_const
-        psi[fluid] = vals
-        psi[solid] = self._rigid_psi(xi[solid], eta[solid], t_new) + rigid_const
+        vals[~ok] = self._rigid_psi(*geo["lost"], t_new) + rigid_const
+        psi[geo["fluid"]] = vals
+        psi[geo["solid"]] = self._rigid_psi(*geo["in_body"], t_new) + rigid_const
         i0, j0, j1 = geo["i0"], geo["j0"], geo["j1"]
         hy = grid.hy_cells()[g + j0:g + j1]
         ju, iu = geo["u_faces"]
@@ -545,7 +555,7 @@ class BodyFittedSST:
 
         self.pair = pair
         self._ghost_cache = None   # (the time's key, the ghost rings' k and omega then)
-        self._donor_cache = None   # (the body's pose, the hole's cells and their O-grid donors then)
+        self._donor_cache = _WhilePoseStays(pair.motion)   # the hole's cells and their O-grid donors
         og = pair.body.grid
         wall = SimpleNamespace(vertices=np.column_stack([og.x[0], og.y[0]]))
         self.background = KOmegaSST(pair.background, k_inf, omega_inf, "resolved",
@@ -584,17 +594,13 @@ class BodyFittedSST:
 
     def _hole_donors(self, t: float):
         """The hole's cells at t (:meth:`hole_cells`) and, for those in the fluid, their places in the O-grid
-        (which of them, donor rows, donor columns); kept while the body's pose stays, as the pair's hole faces."""
-        pose = tuple(float(p) for p in self.pair.motion.pose(t))
-        if self._donor_cache is None or self._donor_cache[0] != pose:
-            (J, I), xi, eta, solid = self.hole_cells(t)
-            donors = (np.zeros(0, dtype=int), np.zeros(0), np.zeros(0))
-            if J.size:
-                jf, if_ = self.pair.locator.locate(xi[~solid], eta[~solid])
-                ok = np.isfinite(jf)
-                donors = (np.nonzero(~solid)[0][ok], jf[ok], if_[ok])
-            self._donor_cache = (pose, (J, I, *donors))
-        return self._donor_cache[1]
+        (which of them, donor rows, donor columns)."""
+        (J, I), xi, eta, solid = self.hole_cells(t)
+        if not J.size:
+            return J, I, np.zeros(0, dtype=int), np.zeros(0), np.zeros(0)
+        jf, if_ = self.pair.locator.locate(xi[~solid], eta[~solid])
+        ok = np.isfinite(jf)
+        return J, I, np.nonzero(~solid)[0][ok], jf[ok], if_[ok]
 
     def transport_body(self, dt: float) -> None:
         """The O-grid's k and omega over the (sub-)step its flow has just taken."""
@@ -606,7 +612,7 @@ class BodyFittedSST:
         bg, body, t = self.background, self.body, self.pair.t
         self._ghost_cache = None   # the background's k and omega change now
         bg.update()
-        J, I, fluid, jf, if_ = self._hole_donors(t)
+        J, I, fluid, jf, if_ = self._donor_cache.get(t, self._hole_donors)
         if J.size:
             k, w = np.full(J.size, self.k_inf), np.full(J.size, self.omega_inf)
             k[fluid] = self.pair.locator.cells(body.k, jf, if_)

@@ -255,7 +255,6 @@ def test_summary_json_is_strict_json(tmp_path):
     assert not [k for k, v in s.items() if v == "none"]
 
 
-
 def test_json_value_turns_every_missing_number_into_null_and_unwraps_numpy():
     """bridge.results.json_value, which the summary and the tools' JSON go through: NaN and infinities as null
     at any depth (a 0-d array's too), NumPy scalars and arrays as plain values."""
