@@ -26,8 +26,11 @@ def lowest_modes(K: sp.spmatrix, M: sp.spmatrix, n_modes: int, shift_hz: float =
     sigma = -(2.0 * np.pi * shift_hz) ** 2 if shift_hz < 0 else (2.0 * np.pi * shift_hz) ** 2
     lu = spla.splu((K - sigma * M).tocsc())
     op = spla.LinearOperator((n, n), matvec=lu.solve, dtype=np.float64)
+    # a fixed start vector: ARPACK's own is drawn from a seed it carries from call to call, so the same model
+    # gave modes differing in the last bits depending on what the process had solved before
+    v0 = np.random.default_rng(0).standard_normal(n)
     try:
-        lam, vec = spla.eigsh(K, k=n_modes, M=M, sigma=sigma, which="LM", OPinv=op, tol=tol,
+        lam, vec = spla.eigsh(K, k=n_modes, M=M, sigma=sigma, which="LM", OPinv=op, tol=tol, v0=v0,
                               ncv=min(n, max(2 * n_modes + 1, 60)))
     except spla.ArpackNoConvergence as err:
         raise ConvergenceError("shift-invert Lanczos (eigsh)", 0, float(len(err.eigenvalues)), tol) from None
